@@ -1,0 +1,1 @@
+"""The inspection cell: configuration, controller link, runner, store, recording and CLI."""

@@ -1,0 +1,70 @@
+"""The ``holecell`` command line: one subcommand module each under :mod:`cell.commands`.
+
+User mistakes (every package's error base, and missing files) are printed as one
+clear message on stderr with exit code 2, never as a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+from collections.abc import Sequence
+
+#: subcommand modules under ``cell.commands``, in the order ``--help`` lists them
+COMMAND_MODULES: tuple[str, ...] = ("cell_show",)
+
+
+def _user_error_types() -> tuple[type[BaseException], ...]:
+    from cell.errors import CellError
+    from robots.errors import RobotModelError
+
+    types: list[type[BaseException]] = [CellError, RobotModelError, FileNotFoundError]
+    for module, name in (
+        ("planner.errors", "PlanningError"),
+        ("measure.errors", "MeasurementError"),
+    ):
+        try:
+            types.append(getattr(importlib.import_module(module), name))
+        except (ImportError, AttributeError):
+            continue
+    return tuple(types)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every registered subcommand."""
+    parser = argparse.ArgumentParser(
+        prog="holecell",
+        description="Robot-vision hole inspection cells: plan tours, run them, measure holes.",
+    )
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMAND_MODULES:
+        importlib.import_module(f"cell.commands.{name}").register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``holecell`` console script; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(
+        level=logging.INFO if args.verbose else logging.WARNING,
+        format="%(levelname)s %(name)s: %(message)s",
+    )
+    if not getattr(args, "handler", None):
+        parser.print_help()
+        return 0 if args.command is None else 2
+    try:
+        return int(args.handler(args) or 0)
+    except _user_error_types() as exc:
+        print(f"holecell {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"holecell {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

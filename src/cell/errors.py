@@ -1,0 +1,17 @@
+"""Exceptions of the ``cell`` package: one base, specific subclasses with payloads."""
+
+from __future__ import annotations
+
+
+class CellError(Exception):
+    """Base of every error raised by :mod:`cell`. The CLI prints its message, no traceback."""
+
+
+class ConfigError(CellError):
+    """A cell file is invalid. ``problems`` lists ``(field path, value, message)``."""
+
+    def __init__(self, path: str, problems: list[tuple[str, object, str]]) -> None:
+        self.path = path
+        self.problems = problems
+        lines = [f"{path}: {field}: {msg} (value: {value!r})" for field, value, msg in problems]
+        super().__init__("\n".join(lines) if lines else f"{path}: invalid cell file")

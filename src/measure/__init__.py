@@ -1,0 +1,1 @@
+"""Stereo hole measurement: calibration, sub-pixel edges, triangulation, circle fit."""

@@ -1,0 +1,1 @@
+"""Inspection tour planning: viewpoints, sequencing, collision-free paths, timing."""

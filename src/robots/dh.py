@@ -1,0 +1,109 @@
+"""Classic (distal) Denavit-Hartenberg tables of the ABB models.
+
+Link i maps frame i-1 to frame i by ``Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``
+with ``theta_i = q_i + theta_offset_i``. Frame 0 is ``base_link``; frame 6 is
+``tool0``. Lengths in metres, angles in radians. For the ABB chains:
+
+    theta offset = [0, -pi/2, 0, 0, 0, pi]
+    alpha        = [-pi/2, 0, -pi/2, pi/2, -pi/2, 0]
+    d            = [d1, 0, 0, d4, 0, d6]
+    a            = [a1, a2, a3, 0, 0, 0]
+
+The thermal model (:mod:`robots.thermal`) scales ``a`` and ``d`` and adds
+offsets to ``theta``; so forward kinematics takes the table as an argument.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from robots.models import MODELS, ArmSpec
+
+Array = NDArray[np.float64]
+
+_PI = math.pi
+
+
+@dataclass(frozen=True)
+class DHTable:
+    """A six-link classic D-H table (m, rad)."""
+
+    a_m: tuple[float, ...]
+    d_m: tuple[float, ...]
+    alpha_rad: tuple[float, ...]
+    theta_offset_rad: tuple[float, ...]
+
+    def arrays(self) -> tuple[Array, Array, Array, Array]:
+        """``(a, d, alpha, theta_offset)`` as float arrays."""
+        return (
+            np.asarray(self.a_m, float),
+            np.asarray(self.d_m, float),
+            np.asarray(self.alpha_rad, float),
+            np.asarray(self.theta_offset_rad, float),
+        )
+
+    def with_lengths(self, a_m: ArrayLike, d_m: ArrayLike) -> DHTable:
+        """A copy with other link lengths (m)."""
+        return replace(self, a_m=tuple(map(float, a_m)), d_m=tuple(map(float, d_m)))
+
+    def with_offsets(self, theta_offset_rad: ArrayLike) -> DHTable:
+        """A copy with other joint offsets (rad)."""
+        return replace(self, theta_offset_rad=tuple(map(float, theta_offset_rad)))
+
+
+def dh_table(spec: ArmSpec | str) -> DHTable:
+    """The D-H table of a built-in model (by spec or name)."""
+    if isinstance(spec, str):
+        spec = MODELS[spec]
+    return DHTable(
+        a_m=(spec.a1, spec.a2, spec.a3, 0.0, 0.0, 0.0),
+        d_m=(spec.d1, 0.0, 0.0, spec.d4, 0.0, spec.d6),
+        alpha_rad=(-_PI / 2, 0.0, -_PI / 2, _PI / 2, -_PI / 2, 0.0),
+        theta_offset_rad=(0.0, -_PI / 2, 0.0, 0.0, 0.0, _PI),
+    )
+
+
+def link_transforms(table: DHTable, q: ArrayLike) -> Array:
+    """Per-link transforms ``T_{i-1,i}``, shape ``(..., 6, 4, 4)``, for joints ``q`` (..., 6)."""
+    a, d, alpha, offset = table.arrays()
+    theta = np.asarray(q, dtype=float) + offset
+    ct, st = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    T = np.zeros((*theta.shape, 4, 4))
+    T[..., 0, 0] = ct
+    T[..., 0, 1] = -st * ca
+    T[..., 0, 2] = st * sa
+    T[..., 0, 3] = a * ct
+    T[..., 1, 0] = st
+    T[..., 1, 1] = ct * ca
+    T[..., 1, 2] = -ct * sa
+    T[..., 1, 3] = a * st
+    T[..., 2, 1] = sa
+    T[..., 2, 2] = ca
+    T[..., 2, 3] = d
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def fk_dh(table: DHTable, q: ArrayLike) -> Array:
+    """``T_base_tool0`` from the D-H table; ``q`` of shape (6,) or (N, 6) gives (4, 4) or (N, 4, 4)."""
+    T_links = link_transforms(table, q)
+    T = T_links[..., 0, :, :]
+    for i in range(1, 6):
+        T = T @ T_links[..., i, :, :]
+    return T
+
+
+def fk_dh_frames(table: DHTable, q: ArrayLike) -> Array:
+    """All D-H frames ``T_base_i`` for i = 0..6, shape ``(..., 7, 4, 4)``."""
+    T_links = link_transforms(table, q)
+    shape = T_links.shape[:-3]
+    out = np.zeros((*shape, 7, 4, 4))
+    out[..., 0, :, :] = np.eye(4)
+    for i in range(6):
+        out[..., i + 1, :, :] = out[..., i, :, :] @ T_links[..., i, :, :]
+    return out
