@@ -1,5 +1,35 @@
 """ABB arm models: URDF, Pinocchio model, kinematics, collision and thermal error model."""
 
-from robots.errors import RobotModelError
+from robots.arm import Arm, LimitScaling, urdf_path
+from robots.dh import DHTable, dh_table, fk_dh
+from robots.errors import (
+    JointVectorError,
+    RobotModelError,
+    ShapeError,
+    UnknownModelError,
+    UrdfError,
+)
+from robots.ik import IKResult, solve_ik
+from robots.models import DEFAULT_MODEL, JOINT_NAMES, MODELS, ArmSpec
+from robots.shapes import Shape
 
-__all__ = ["RobotModelError"]
+__all__ = [
+    "DEFAULT_MODEL",
+    "JOINT_NAMES",
+    "MODELS",
+    "Arm",
+    "ArmSpec",
+    "DHTable",
+    "IKResult",
+    "JointVectorError",
+    "LimitScaling",
+    "RobotModelError",
+    "Shape",
+    "ShapeError",
+    "UnknownModelError",
+    "UrdfError",
+    "dh_table",
+    "fk_dh",
+    "solve_ik",
+    "urdf_path",
+]

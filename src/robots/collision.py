@@ -1,0 +1,179 @@
+"""The collision model of an arm with its tool and the cell's obstacles.
+
+Built on Pinocchio's :class:`GeometryModel` (coal underneath). Pairs checked:
+every two robot bodies that are not adjacent in the chain (the tool counts as
+a body on ``link_6``), and every robot body against every obstacle. Pairs of
+robot bodies already touching at q = 0 are design overlaps of the coarse
+shapes and are left out (reported in :attr:`CollisionModel.excluded_pairs`).
+
+Speed: coal's dynamic AABB tree (a Pinocchio broad-phase manager) culls the
+pairs whose boxes do not overlap; only the rest get the exact primitive test.
+Every request starts GJK from coal's default guess, never the previous
+result, so overlaps between cylinders are not missed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from robots.shapes import Shape
+
+Array = NDArray[np.float64]
+
+#: bodies of the arm chain, in order; adjacent ones are never checked against each other
+CHAIN_BODIES: tuple[str, ...] = (
+    "base_link",
+    "link_1",
+    "link_2",
+    "link_3",
+    "link_4",
+    "link_5",
+    "link_6",
+    "tool",
+)
+
+
+@dataclass(frozen=True)
+class GeomInfo:
+    """Bookkeeping of one geometry object: its body, a chain body or ``obstacle``."""
+
+    name: str
+    body: str
+
+
+def _body_of(geom: pin.GeometryObject, model: pin.Model) -> str:
+    return model.frames[geom.parentFrame].name
+
+
+def _robot_geoms(model: pin.Model, geom_model: pin.GeometryModel) -> list[GeomInfo]:
+    return [GeomInfo(geom.name, _body_of(geom, model)) for geom in geom_model.geometryObjects]
+
+
+def _add_shape(
+    geom_model: pin.GeometryModel, shape: Shape, name: str, joint: int, frame: int, M: Array
+) -> None:
+    obj = pin.GeometryObject(name, joint, frame, pin.SE3(M), shape.geometry())
+    geom_model.addGeometryObject(obj)
+
+
+class CollisionModel:
+    """Geometry of arm, tool and obstacles with the pairs to check.
+
+    Args:
+        model: the Pinocchio model of the arm.
+        geom_model: the arm's collision geometry (from its URDF).
+        tool_shapes: tool primitives with poses relative to ``tool0``.
+        obstacles: obstacle primitives with poses in the arm's base frame.
+    """
+
+    def __init__(
+        self,
+        model: pin.Model,
+        geom_model: pin.GeometryModel,
+        tool_shapes: list[Shape],
+        obstacles: list[Shape],
+    ) -> None:
+        self.model = model
+        self.geom_model = geom_model.copy()
+        tool0 = model.getFrameId("tool0")
+        link6_joint = model.frames[tool0].parentJoint
+        M_joint_tool0 = model.frames[tool0].placement.homogeneous
+        self.infos = _robot_geoms(model, self.geom_model)
+        for i, shape in enumerate(tool_shapes):
+            name = f"tool_{i}:{shape.name}"
+            _add_shape(self.geom_model, shape, name, link6_joint, tool0, M_joint_tool0 @ shape.T)
+            self.infos.append(GeomInfo(name, "tool"))
+        universe = model.getFrameId("universe")
+        for i, shape in enumerate(obstacles):
+            name = f"obstacle_{i}:{shape.name}"
+            _add_shape(self.geom_model, shape, name, 0, universe, shape.T)
+            self.infos.append(GeomInfo(name, "obstacle"))
+        self.data = model.createData()
+        self.excluded_pairs: list[tuple[str, str]] = []
+        self._build_pairs()
+
+    def _candidate_pairs(self) -> list[tuple[int, int]]:
+        pairs = []
+        order = {body: k for k, body in enumerate(CHAIN_BODIES)}
+        for i, a in enumerate(self.infos):
+            for j in range(i + 1, len(self.infos)):
+                b = self.infos[j]
+                if a.body == "obstacle" and b.body == "obstacle":
+                    continue
+                if a.body != "obstacle" and b.body != "obstacle":
+                    if abs(order[a.body] - order[b.body]) <= 1:
+                        continue
+                pairs.append((i, j))
+        return pairs
+
+    def _build_pairs(self) -> None:
+        candidates = self._candidate_pairs()
+        for i, j in candidates:
+            self.geom_model.addCollisionPair(pin.CollisionPair(i, j))
+        self.geom_data = pin.GeometryData(self.geom_model)
+        q0 = pin.neutral(self.model)
+        pin.updateGeometryPlacements(self.model, self.data, self.geom_model, self.geom_data, q0)
+        drop = []
+        for k, (i, j) in enumerate(candidates):
+            robot_pair = "obstacle" not in (self.infos[i].body, self.infos[j].body)
+            if robot_pair and pin.computeCollision(self.geom_model, self.geom_data, k):
+                drop.append(k)
+                self.excluded_pairs.append((self.infos[i].name, self.infos[j].name))
+        for k in reversed(drop):
+            self.geom_model.removeCollisionPair(self.geom_model.collisionPairs[k])
+        self.geom_data = pin.GeometryData(self.geom_model)
+        self._configure_requests()
+        self.broadphase = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(
+            self.model, self.geom_model, self.geom_data
+        )
+
+    def _configure_requests(self) -> None:
+        for req in self.geom_data.collisionRequests:
+            req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
+            req.enable_cached_gjk_guess = False
+            req.security_margin = 0.0
+        for req in self.geom_data.distanceRequests:
+            req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
+            req.enable_cached_gjk_guess = False
+
+    def in_collision(self, q: Array) -> bool:
+        """True when any checked pair touches or overlaps at ``q`` (rad).
+
+        Uses coal's dynamic AABB tree to cull pairs, then exact primitive tests.
+        """
+        return bool(pin.computeCollisions(self.model, self.data, self.broadphase, q, True))
+
+    def in_collision_exhaustive(self, q: Array) -> bool:
+        """Same answer as :meth:`in_collision`, testing every pair (reference for tests)."""
+        return bool(
+            pin.computeCollisions(self.model, self.data, self.geom_model, self.geom_data, q, True)
+        )
+
+    def colliding_pairs(self, q: Array) -> list[tuple[str, str]]:
+        """Names of every pair in contact at ``q`` (rad)."""
+        pin.computeCollisions(self.model, self.data, self.geom_model, self.geom_data, q, False)
+        names = [g.name for g in self.geom_model.geometryObjects]
+        out = []
+        for pair, result in zip(
+            self.geom_model.collisionPairs, self.geom_data.collisionResults, strict=True
+        ):
+            if result.isCollision():
+                out.append((names[pair.first], names[pair.second]))
+        return out
+
+    def clearance(self, q: Array) -> tuple[float, tuple[str, str]]:
+        """Smallest distance (m) over the checked pairs at ``q`` and the pair's names.
+
+        Negative when shapes penetrate (coal's signed distance for primitives).
+        """
+        pin.computeDistances(self.model, self.data, self.geom_model, self.geom_data, q)
+        distances = np.array([r.min_distance for r in self.geom_data.distanceResults])
+        k = int(np.argmin(distances))
+        pair = self.geom_model.collisionPairs[k]
+        names = self.geom_model.geometryObjects
+        return float(distances[k]), (names[pair.first].name, names[pair.second].name)

@@ -1,0 +1,75 @@
+"""Temperature error compensation on the D-H model.
+
+- :mod:`~robots.thermal.model`: the model (``ThermalSpec``, ``ThermalModel``), D-H lengths
+  growing linearly with their link's temperature, optional joint-offset drift.
+- :mod:`~robots.thermal.identify`: identification from reference-target observations
+  (Levenberg-Marquardt) with the rank/condition report and refusal of what the data
+  cannot determine.
+- :mod:`~robots.thermal.compensate`: the measurement transform and the command at one pose.
+- :mod:`~robots.thermal.drift`: the drift generator (hidden truth for simulation and tests).
+- :mod:`~robots.thermal.observations`: observation sets, cell geometry, simulated observations.
+- :mod:`~robots.thermal.csvio` and :mod:`~robots.thermal.modelfile`: the CSV formats and thermal.json.
+"""
+
+from robots.thermal.compensate import (
+    CommandOptions,
+    CommandResult,
+    camera_to_part,
+    command,
+    compensated_T_base_tcp,
+    solve_tcp,
+    T_part_camera,
+)
+from robots.thermal.drift import (
+    MATERIAL_EXPANSION_PER_K,
+    DriftSettings,
+    DriftTruth,
+    WarmUp,
+    default_settings,
+)
+from robots.thermal.errors import (
+    ThermalDataError,
+    ThermalError,
+    ThermalModelFileError,
+    ThermalSpecError,
+    UnidentifiableError,
+)
+from robots.thermal.identify import (
+    IdentificationResult,
+    IdentifiabilityReport,
+    IdentifyOptions,
+    identify,
+    reference_from_cold,
+)
+from robots.thermal.model import ThermalModel, ThermalSpec
+from robots.thermal.observations import CellGeometry, Observations, simulate_observations
+
+__all__ = [
+    "MATERIAL_EXPANSION_PER_K",
+    "CellGeometry",
+    "CommandOptions",
+    "CommandResult",
+    "DriftSettings",
+    "DriftTruth",
+    "IdentifiabilityReport",
+    "IdentificationResult",
+    "IdentifyOptions",
+    "Observations",
+    "T_part_camera",
+    "ThermalDataError",
+    "ThermalError",
+    "ThermalModel",
+    "ThermalModelFileError",
+    "ThermalSpec",
+    "ThermalSpecError",
+    "UnidentifiableError",
+    "WarmUp",
+    "camera_to_part",
+    "command",
+    "compensated_T_base_tcp",
+    "default_settings",
+    "identify",
+    "reference_from_cold",
+    "simulate_observations",
+    "solve_tcp",
+]
