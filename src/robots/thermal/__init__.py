@@ -8,17 +8,17 @@
 - :mod:`~robots.thermal.compensate`: the measurement transform and the command at one pose.
 - :mod:`~robots.thermal.drift`: the drift generator (hidden truth for simulation and tests).
 - :mod:`~robots.thermal.observations`: observation sets, cell geometry, simulated observations.
-- :mod:`~robots.thermal.csvio` and :mod:`~robots.thermal.modelfile`: the CSV formats and thermal.json.
+- :mod:`~robots.thermal.csvio`, :mod:`~robots.thermal.modelfile`: CSV formats, thermal.json.
 """
 
 from robots.thermal.compensate import (
     CommandOptions,
     CommandResult,
+    T_part_camera,
     camera_to_part,
     command,
     compensated_T_base_tcp,
     solve_tcp,
-    T_part_camera,
 )
 from robots.thermal.drift import (
     MATERIAL_EXPANSION_PER_K,
@@ -35,8 +35,8 @@ from robots.thermal.errors import (
     UnidentifiableError,
 )
 from robots.thermal.identify import (
-    IdentificationResult,
     IdentifiabilityReport,
+    IdentificationResult,
     IdentifyOptions,
     identify,
     reference_from_cold,

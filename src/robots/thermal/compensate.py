@@ -27,7 +27,7 @@ Array = NDArray[np.float64]
 
 
 def compensated_T_base_tcp(model: ThermalModel, q: ArrayLike, temps_degC: ArrayLike) -> Array:
-    """``T_base_tcp`` (..., 4, 4) of the compensated model at joints ``q`` and sensor readings (degC)."""
+    """Compensated ``T_base_tcp`` (..., 4, 4) at joints ``q`` (rad) and sensor readings (degC)."""
     return model.fk(q, temps_degC) @ model.T_tool0_tcp
 
 
@@ -38,7 +38,7 @@ def T_part_camera(
     T_cell_part: ArrayLike,
     T_tcp_cam: ArrayLike | None = None,
 ) -> Array:
-    """``T_part_cam`` (4x4): maps camera-frame coordinates into the part frame at this pose and moment.
+    """``T_part_cam`` (4x4): camera-frame coordinates into the part frame at this pose and moment.
 
     ``T_cell_part`` is the part pose in the cell; ``T_tcp_cam`` the camera frame in the
     TCP frame (identity when the measurement is expressed in the TCP frame).
@@ -79,7 +79,7 @@ class CommandOptions:
 
 @dataclass(frozen=True)
 class CommandResult:
-    """A joint vector (rad) putting the TCP at a goal pose; ``status`` "converged" or "not converged"."""
+    """Joints (rad) putting the TCP at a goal pose; ``status`` "converged" or "not converged"."""
 
     status: str
     q_rad: Array
@@ -128,7 +128,9 @@ def solve_tcp(
         J, T = _jacobian(table, q, T_tt)
         e_p, e_w = _pose_error(T_goal, T)
         ep, ew = float(np.linalg.norm(e_p)), float(np.linalg.norm(e_w))
-        done = ep <= options.position_tol_m and (options.position_only or ew <= options.rotation_tol_rad)
+        done = ep <= options.position_tol_m and (
+            options.position_only or ew <= options.rotation_tol_rad
+        )
         if done or it >= options.max_iterations:
             break
         Jr = J[rows]
@@ -152,7 +154,7 @@ def command(
     temps_degC: ArrayLike,
     options: CommandOptions | None = None,
 ) -> CommandResult:
-    """The joint vector putting the TCP at its nominal pose ``fk_nominal(q_nominal)`` at these temperatures.
+    """Joints putting the TCP at its nominal pose ``fk_nominal(q_nominal)`` at these temperatures.
 
     The nominal pose is what the planner computed on the nominal table; the result
     drives the compensated (warm) arm there. Starts from ``q_nominal``.

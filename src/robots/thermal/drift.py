@@ -36,12 +36,14 @@ MATERIAL_EXPANSION_PER_K: dict[str, float] = {
 class WarmUp:
     """A first-order warm-up curve: ``rise_K * (1 - exp(-t / tau_s))`` above ambient."""
 
-    rise_K: float
+    rise_K: float  # noqa: N815 (unit suffix)
     tau_s: float
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.rise_K) and np.isfinite(self.tau_s) and self.tau_s > 0):
-            raise ThermalSpecError("warm-up", (self.rise_K, self.tau_s), "need a finite rise, tau > 0 s")
+            raise ThermalSpecError(
+                "warm-up", (self.rise_K, self.tau_s), "need a finite rise, tau > 0 s"
+            )
 
     def rise_at(self, t_s: ArrayLike) -> Array:
         """Temperature rise (K) at times ``t_s`` (s); zero before t = 0."""
@@ -67,9 +69,9 @@ class DriftSettings:
     link_warmup: tuple[WarmUp, ...]
     sensor_names: tuple[str, ...]
     sensor_warmup: tuple[WarmUp, ...]
-    ambient_degC: float = 20.0
-    sensor_noise_K: float = 0.0
-    offset_drift_rad_per_K: tuple[float, ...] = (0.0,) * N_LINKS
+    ambient_degC: float = 20.0  # noqa: N815 (unit suffix)
+    sensor_noise_K: float = 0.0  # noqa: N815 (unit suffix)
+    offset_drift_rad_per_K: tuple[float, ...] = (0.0,) * N_LINKS  # noqa: N815 (unit suffix)
 
     def __post_init__(self) -> None:
         if len(self.materials) != N_LINKS or len(self.link_warmup) != N_LINKS:
@@ -80,9 +82,13 @@ class DriftSettings:
                 "materials", unknown, f"known materials: {sorted(MATERIAL_EXPANSION_PER_K)}"
             )
         if len(self.sensor_names) != len(self.sensor_warmup) or not self.sensor_names:
-            raise ThermalSpecError("sensors", self.sensor_names, "one warm-up curve per sensor needed")
+            raise ThermalSpecError(
+                "sensors", self.sensor_names, "one warm-up curve per sensor needed"
+            )
         if len(self.offset_drift_rad_per_K) != N_LINKS:
-            raise ThermalSpecError("offset_drift_rad_per_K", self.offset_drift_rad_per_K, "six values")
+            raise ThermalSpecError(
+                "offset_drift_rad_per_K", self.offset_drift_rad_per_K, "six values"
+            )
         if self.sensor_noise_K < 0:
             raise ThermalSpecError("sensor_noise_K", self.sensor_noise_K, "must be >= 0")
 
@@ -159,7 +165,7 @@ class DriftTruth:
 
 
 def default_settings(per_joint_noise_K: float = 0.05) -> DriftSettings:
-    """The reference warm-up: two hours to about +15 K, aluminium arm links, steel base and wrist."""
+    """The reference warm-up: two hours to about +15 K, aluminium arm links, steel wrist."""
     return DriftSettings.per_joint(
         materials=("cast_iron", "aluminium", "steel", "aluminium", "steel", "steel"),
         link_warmup=(
@@ -172,4 +178,3 @@ def default_settings(per_joint_noise_K: float = 0.05) -> DriftSettings:
         ),
         sensor_noise_K=per_joint_noise_K,
     )
-

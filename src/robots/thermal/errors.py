@@ -42,7 +42,9 @@ class UnidentifiableError(ThermalError):
         self.reason = reason
         self.refused = dict(refused or {})
         details = "; ".join(f"{k}: {v}" for k, v in self.refused.items())
-        super().__init__(f"thermal identification impossible: {reason}" + (f" ({details})" if details else ""))
+        super().__init__(
+            f"thermal identification impossible: {reason}" + (f" ({details})" if details else "")
+        )
 
 
 class ThermalModelFileError(ThermalError):

@@ -106,7 +106,9 @@ def reference_from_cold(obs: Observations) -> tuple[float, ...]:
 class _Problem:
     """Group-demeaned deviations of the observations and of the model's predictions."""
 
-    def __init__(self, obs: Observations, geometry: CellGeometry, table: DHTable, spec: ThermalSpec):
+    def __init__(
+        self, obs: Observations, geometry: CellGeometry, table: DHTable, spec: ThermalSpec
+    ):
         self.table = table
         self.geometry = geometry
         self.q = obs.q_rad
@@ -125,7 +127,10 @@ class _Problem:
 
     def predicted(self, terms: tuple[str, ...], x: Array) -> Array:
         """Demeaned predicted positions (N, 3) for scaled term values ``x``."""
-        values = {n: float(v) * TERM_SCALE[term_kind_and_link(n)[0]] for n, v in zip(terms, x, strict=True)}
+        values = {
+            n: float(v) * TERM_SCALE[term_kind_and_link(n)[0]]
+            for n, v in zip(terms, x, strict=True)
+        }
         k, c = coefficient_vectors(values)
         a, d, alpha, theta = drifted_arrays(self.table, k, c, self.dT)
         T = fk_rows(a, d, alpha, theta, self.q)
@@ -140,7 +145,9 @@ class _Problem:
         for j in range(len(terms)):
             e = np.zeros(len(terms))
             e[j] = step
-            cols.append((self.predicted(terms, x + e) - self.predicted(terms, x - e)).ravel() / (2 * step))
+            cols.append(
+                (self.predicted(terms, x + e) - self.predicted(terms, x - e)).ravel() / (2 * step)
+            )
         return np.column_stack(cols) if cols else np.zeros((3 * len(self.q), 0))
 
 
@@ -168,7 +175,7 @@ def _condition(s: Array) -> float:
 def identifiability(
     problem: _Problem, spec: ThermalSpec, options: IdentifyOptions
 ) -> IdentifiabilityReport:
-    """Refuse terms without effect, then the least separable ones until the condition is acceptable."""
+    """Refuse terms without effect, then the least separable ones until the condition is met."""
     candidates = spec.candidate_terms()
     J = problem.jacobian(candidates, np.zeros(len(candidates)))
     norms = np.linalg.norm(J, axis=0)
@@ -186,12 +193,16 @@ def identifiability(
         if _condition(s) <= options.max_condition:
             break
         v = Vt[-1]
-        worst = int(np.argmax(np.abs(v)))
+        # among the terms in the least determined combination, drop the one with the smallest
+        # effect: the others keep its share as an effective coefficient
+        involved = np.flatnonzero(np.abs(v) >= 0.5 * np.max(np.abs(v)))
+        worst = int(involved[np.argmin(norms[np.asarray(kept)[involved]])])
         partners = [
             f"{v[i]:+.2f}*{candidates[kept[i]]}" for i in np.argsort(-np.abs(v)) if abs(v[i]) > 0.1
         ]
         refused[candidates[kept[worst]]] = (
-            "not separable from the other terms with this pose plan and these temperatures "
+            "not separable from the other terms with this pose plan and these temperatures, "
+            "its share goes to the kept terms "
             f"(condition {_condition(s):.3g} > {options.max_condition:.3g}; "
             f"least determined combination {' '.join(partners)})"
         )
@@ -216,7 +227,7 @@ def identify(
     options: IdentifyOptions | None = None,
     robot_model: str = "",
 ) -> IdentificationResult:
-    """Identify the thermal terms of ``spec`` from observations; refuse what the data cannot determine.
+    """Identify the terms of ``spec`` from observations; refuse what the data cannot determine.
 
     Raises :class:`UnidentifiableError` when no term can be determined or there are
     too few observations for the kept terms.

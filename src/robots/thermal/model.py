@@ -61,7 +61,7 @@ class ThermalSpec:
 
     sensor_names: tuple[str, ...]
     sensor_of_link: tuple[int, ...]
-    reference_degC: tuple[float, ...]
+    reference_degC: tuple[float, ...]  # noqa: N815 (unit suffix)
     lengths: bool = True
     offsets: bool = False
 
@@ -74,9 +74,13 @@ class ThermalSpec:
             raise ThermalSpecError("sensor_of_link", self.sensor_of_link, "needs six entries")
         for s in self.sensor_of_link:
             if not 0 <= int(s) < len(self.sensor_names):
-                raise ThermalSpecError("sensor_of_link", self.sensor_of_link, "sensor index out of range")
+                raise ThermalSpecError(
+                    "sensor_of_link", self.sensor_of_link, "sensor index out of range"
+                )
         if len(self.reference_degC) != len(self.sensor_names):
-            raise ThermalSpecError("reference_degC", self.reference_degC, "one value per sensor needed")
+            raise ThermalSpecError(
+                "reference_degC", self.reference_degC, "one value per sensor needed"
+            )
         if not np.all(np.isfinite(self.reference_degC)):
             raise ThermalSpecError("reference_degC", self.reference_degC, "values must be finite")
         if not (self.lengths or self.offsets):
@@ -87,7 +91,7 @@ class ThermalSpec:
         return (LENGTH_TERMS if self.lengths else ()) + (OFFSET_TERMS if self.offsets else ())
 
     def link_delta_K(self, temps_degC: ArrayLike) -> Array:
-        """Per-link temperature rise over the reference (K), shape ``(..., 6)``, from sensor readings."""
+        """Per-link rise over the reference (K), shape ``(..., 6)``, from sensor readings (degC)."""
         temps = np.asarray(temps_degC, dtype=float)
         if temps.shape[-1] != len(self.sensor_names):
             raise ThermalSpecError(
@@ -103,7 +107,7 @@ class ThermalSpec:
         link_sensors: tuple[str, ...] | None = None,
         offsets: bool = False,
     ) -> ThermalSpec:
-        """A spec from sensor names: one sensor drives every link; six map in order; else ``link_sensors``."""
+        """A spec: one sensor drives every link; six map in order; else give ``link_sensors``."""
         if link_sensors is None:
             if len(sensor_names) == 1:
                 link_sensors = sensor_names * N_LINKS
@@ -113,13 +117,17 @@ class ThermalSpec:
                 raise ThermalSpecError(
                     "sensor map",
                     sensor_names,
-                    "with neither one nor six sensors, say which sensor drives each of the six links",
+                    "with neither one nor six sensors, say which sensor drives each link",
                 )
         if len(link_sensors) != N_LINKS:
-            raise ThermalSpecError("sensor map", link_sensors, "needs six sensor names, one per link")
+            raise ThermalSpecError(
+                "sensor map", link_sensors, "needs six sensor names, one per link"
+            )
         unknown = [s for s in link_sensors if s not in sensor_names]
         if unknown:
-            raise ThermalSpecError("sensor map", unknown, f"not among the sensors {list(sensor_names)}")
+            raise ThermalSpecError(
+                "sensor map", unknown, f"not among the sensors {list(sensor_names)}"
+            )
         return ThermalSpec(
             sensor_names=tuple(sensor_names),
             sensor_of_link=tuple(sensor_names.index(s) for s in link_sensors),
@@ -128,7 +136,9 @@ class ThermalSpec:
         )
 
 
-def drifted_arrays(table: DHTable, k_per_K: ArrayLike, c_rad_per_K: ArrayLike, dT_link_K: ArrayLike) -> tuple[Array, Array, Array, Array]:
+def drifted_arrays(
+    table: DHTable, k_per_K: ArrayLike, c_rad_per_K: ArrayLike, dT_link_K: ArrayLike
+) -> tuple[Array, Array, Array, Array]:
     """D-H arrays ``(a, d, alpha, theta_offset)`` at per-link rises ``dT_link_K`` (..., 6).
 
     ``k_per_K`` (6,) scales the lengths of each link, ``c_rad_per_K`` (6,) drifts the joint offsets.
@@ -142,7 +152,7 @@ def drifted_arrays(table: DHTable, k_per_K: ArrayLike, c_rad_per_K: ArrayLike, d
 
 
 def fk_rows(a: Array, d: Array, alpha: Array, theta_offset: Array, q: ArrayLike) -> Array:
-    """``T_base_tool0`` (..., 4, 4) for D-H arrays that may differ per row (same convention as ``fk_dh``)."""
+    """``T_base_tool0`` (..., 4, 4) for D-H arrays that may differ per row (as ``fk_dh``)."""
     theta = np.asarray(q, dtype=float) + theta_offset
     ct, st = np.cos(theta), np.sin(theta)
     ca, sa = np.cos(alpha), np.sin(alpha)
@@ -167,7 +177,7 @@ def fk_rows(a: Array, d: Array, alpha: Array, theta_offset: Array, q: ArrayLike)
 
 
 def coefficient_vectors(coefficients: Mapping[str, float]) -> tuple[Array, Array]:
-    """Full ``(k (6,) 1/K, c (6,) rad/K)`` vectors from a term-to-value map; absent terms are zero."""
+    """Full ``(k (6,) 1/K, c (6,) rad/K)`` from a term-to-value map; absent terms are zero."""
     k = np.zeros(N_LINKS)
     c = np.zeros(N_LINKS)
     for name, value in coefficients.items():
@@ -220,6 +230,6 @@ class ThermalModel:
         return self.table.with_lengths(a, d).with_offsets(theta)
 
     def fk(self, q: ArrayLike, temps_degC: ArrayLike) -> Array:
-        """Compensated ``T_base_tool0`` for joints ``q`` (..., 6) at sensor readings (..., n_sensors)."""
+        """Compensated ``T_base_tool0`` at joints ``q`` (..., 6) and readings (..., n_sensors)."""
         a, d, alpha, theta = self.arrays_at(temps_degC)
         return fk_rows(a, d, alpha, theta, q)

@@ -10,7 +10,7 @@ move as the temperatures change.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,7 +52,7 @@ class Observations:
     time_s: Array
     target_ids: tuple[str, ...]
     q_rad: Array
-    temps_degC: Array
+    temps_degC: Array  # noqa: N815 (unit suffix)
     sensor_names: tuple[str, ...]
     p_tcp_m: Array
     source: str = "observations"
@@ -73,7 +73,9 @@ class Observations:
         }
         for key, shape in shapes.items():
             if shape != expected[key]:
-                raise ThermalDataError(self.source, f"{key} has shape {shape}, expected {expected[key]}")
+                raise ThermalDataError(
+                    self.source, f"{key} has shape {shape}, expected {expected[key]}"
+                )
 
     def __len__(self) -> int:
         return len(self.time_s)
@@ -98,13 +100,15 @@ class Observations:
             if tid not in geometry.targets_cell_m:
                 known = ", ".join(sorted(geometry.targets_cell_m)) or "none"
                 raise ThermalDataError(
-                    self.source, f"unknown target id {tid!r} (the cell's reference targets: {known})",
-                    row=row + 1, column="target_id",
+                    self.source,
+                    f"unknown target id {tid!r} (the cell's reference targets: {known})",
+                    row=row + 1,
+                    column="target_id",
                 )
 
 
 def predict_p_tcp(T_base_tool0: Array, T_tool0_tcp: Array, p_base_m: Array) -> Array:
-    """Target positions in the TCP frame (N, 3) from ``T_base_tool0`` (N, 4, 4) and base positions (N, 3)."""
+    """Target positions (N, 3) in the TCP frame from ``T_base_tool0`` (N, 4, 4), base positions."""
     T_base_tcp = T_base_tool0 @ T_tool0_tcp
     R = T_base_tcp[..., :3, :3]
     t = T_base_tcp[..., :3, 3]
@@ -112,8 +116,8 @@ def predict_p_tcp(T_base_tool0: Array, T_tool0_tcp: Array, p_base_m: Array) -> A
 
 
 def simulate_observations(
-    T_base_tool0_at: object,
-    sensor_readings_at: object,
+    T_base_tool0_at: Callable[[Array, Array], Array],
+    sensor_readings_at: Callable[[Array], Array],
     sensor_names: tuple[str, ...],
     geometry: CellGeometry,
     plan: list[tuple[str, ArrayLike]],
@@ -132,11 +136,11 @@ def simulate_observations(
     ids = [tid for _ in times for tid, _q in plan]
     q = np.array([np.asarray(qq, dtype=float) for _ in times for _t, qq in plan]).reshape(-1, 6)
     t = np.repeat(times, len(plan))
-    T = T_base_tool0_at(q, t)  # type: ignore[operator]
+    T = T_base_tool0_at(q, t)
     p = predict_p_tcp(T, geometry.T_tool0_tcp, geometry.targets_base_m(ids))
     if noise_m > 0:
         p = p + np.random.default_rng(seed).normal(0.0, noise_m, p.shape)
-    temps = np.asarray(sensor_readings_at(t), dtype=float)  # type: ignore[operator]
+    temps = np.asarray(sensor_readings_at(t), dtype=float)
     return Observations(
         time_s=t,
         target_ids=tuple(ids),
