@@ -20,16 +20,21 @@ class ThermalSpecError(ThermalError):
 
 
 class ThermalDataError(ThermalError):
-    """Observations or poses cannot be used (missing file content, bad column, unknown target)."""
+    """Observations or poses cannot be used (bad column, unit, value or unknown target).
 
-    def __init__(self, source: str, reason: str, row: int | None = None, column: str | None = None):
+    ``source`` names the file (or data set), ``line`` the file line (header = line 1).
+    """
+
+    def __init__(
+        self, source: str, reason: str, line: int | None = None, column: str | None = None
+    ) -> None:
         self.source = source
         self.reason = reason
-        self.row = row
+        self.line = line
         self.column = column
         where = source
-        if row is not None:
-            where += f", row {row}"
+        if line is not None:
+            where += f", line {line}"
         if column is not None:
             where += f", column {column!r}"
         super().__init__(f"{where}: {reason}")

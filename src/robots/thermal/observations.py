@@ -56,6 +56,7 @@ class Observations:
     sensor_names: tuple[str, ...]
     p_tcp_m: Array
     source: str = "observations"
+    lines: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         n = len(self.time_s)
@@ -99,10 +100,12 @@ class Observations:
         for row, tid in enumerate(self.target_ids):
             if tid not in geometry.targets_cell_m:
                 known = ", ".join(sorted(geometry.targets_cell_m)) or "none"
+                line = self.lines[row] if self.lines else None
+                where = "" if line else f"observation {row + 1}: "
                 raise ThermalDataError(
                     self.source,
-                    f"unknown target id {tid!r} (the cell's reference targets: {known})",
-                    row=row + 1,
+                    f"{where}unknown target id {tid!r} (the cell's reference targets: {known})",
+                    line=line,
                     column="target_id",
                 )
 

@@ -1,0 +1,157 @@
+"""``thermal.json``: an identified thermal model with its uncertainty and fit report.
+
+Layout (SI units; temperatures in degC)::
+
+    {"format": "holecell.thermal/1", "robot_model": "abb_irb2600_20_165",
+     "dh": {"a_m": [...6], "d_m": [...6], "alpha_rad": [...6], "theta_offset_rad": [...6]},
+     "sensors": {"names": ["j1", ...], "reference_degC": [...], "link_sensors": [...6 names]},
+     "terms": {"lengths": true, "offsets": false},
+     "coefficients": {"k_link2": {"value": 2.3e-05, "std": 4e-07, "unit": "1/K"}, ...},
+     "refused": {"k_link5": "link 5 has no D-H length (a5 = d5 = 0)"},
+     "T_cell_base": {"xyz": [...], "quat_xyzw": [...]}, "T_tool0_tcp": {...},
+     "fit": {"residual_rms_m": ..., "rank": ..., "condition": ..., ...}}
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robots.dh import DHTable
+from robots.thermal.errors import ThermalError, ThermalModelFileError
+from robots.thermal.model import TERM_UNIT, ThermalModel, ThermalSpec, term_kind_and_link
+from robots.transforms import matrix_to_pose, pose_to_matrix
+
+FORMAT = "holecell.thermal/1"
+
+
+def model_to_dict(model: ThermalModel) -> dict[str, Any]:
+    """The JSON-ready description of a model."""
+    spec = model.spec
+    a, d, alpha, theta = model.table.arrays()
+
+    def pose(T: np.ndarray) -> dict[str, list[float]]:
+        p = matrix_to_pose(T)
+        return {"xyz": p["xyz"], "quat_xyzw": p["quat_xyzw"]}
+
+    return {
+        "format": FORMAT,
+        "robot_model": model.robot_model,
+        "dh": {
+            "a_m": a.tolist(),
+            "d_m": d.tolist(),
+            "alpha_rad": alpha.tolist(),
+            "theta_offset_rad": theta.tolist(),
+        },
+        "sensors": {
+            "names": list(spec.sensor_names),
+            "reference_degC": list(spec.reference_degC),
+            "link_sensors": [spec.sensor_names[i] for i in spec.sensor_of_link],
+        },
+        "terms": {"lengths": spec.lengths, "offsets": spec.offsets},
+        "coefficients": {
+            name: {
+                "value": float(value),
+                "std": float(model.std.get(name, math.nan)),
+                "unit": TERM_UNIT[term_kind_and_link(name)[0]],
+            }
+            for name, value in model.coefficients.items()
+        },
+        "refused": dict(model.refused),
+        "T_cell_base": pose(model.T_cell_base),
+        "T_tool0_tcp": pose(model.T_tool0_tcp),
+        "fit": {k: float(v) for k, v in model.fit.items()},
+    }
+
+
+def save_model(path: str | Path, model: ThermalModel) -> None:
+    """Write ``thermal.json`` (NaN uncertainties become null)."""
+    text = json.dumps(model_to_dict(model), indent=2)
+    Path(path).write_text(text.replace("NaN", "null") + "\n", encoding="utf-8")
+
+
+def _get(doc: dict[str, Any], path: str, src: str) -> Any:
+    node: Any = doc
+    for key in path.split("."):
+        if not isinstance(node, dict) or key not in node:
+            raise ThermalModelFileError(src, path, "missing")
+        node = node[key]
+    return node
+
+
+def _vector(doc: dict[str, Any], path: str, src: str, n: int | None = None) -> list[float]:
+    value = _get(doc, path, src)
+    try:
+        out = [float(v) for v in value]
+    except (TypeError, ValueError):
+        raise ThermalModelFileError(
+            src, path, f"expected a list of numbers, got {value!r}"
+        ) from None
+    if (n is not None and len(out) != n) or not all(math.isfinite(v) for v in out):
+        raise ThermalModelFileError(
+            src, path, f"expected {n or 'some'} finite numbers, got {value!r}"
+        )
+    return out
+
+
+def _pose(doc: dict[str, Any], path: str, src: str) -> np.ndarray:
+    return pose_to_matrix(
+        _vector(doc, f"{path}.xyz", src, 3), quat_xyzw=_vector(doc, f"{path}.quat_xyzw", src, 4)
+    )
+
+
+def model_from_dict(doc: Any, src: str = "thermal.json") -> ThermalModel:
+    """A model from its JSON description; raises :class:`ThermalModelFileError` naming the field."""
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise ThermalModelFileError(src, "format", f"expected {FORMAT!r}, found {found!r}")
+    table = DHTable(*(tuple(_vector(doc, f"dh.{k}", src, 6)) for k in DHTable.__dataclass_fields__))
+    names = tuple(str(n) for n in _get(doc, "sensors.names", src))
+    try:
+        spec = ThermalSpec.mapped(
+            names,
+            tuple(_vector(doc, "sensors.reference_degC", src, len(names))),
+            tuple(str(n) for n in _get(doc, "sensors.link_sensors", src)),
+            offsets=bool(_get(doc, "terms.offsets", src)),
+        )
+    except ThermalError as exc:
+        raise ThermalModelFileError(src, "sensors", str(exc)) from None
+    coefficients, std = {}, {}
+    for name, entry in dict(_get(doc, "coefficients", src)).items():
+        try:
+            term_kind_and_link(name)
+            coefficients[name] = float(entry["value"])
+            std[name] = math.nan if entry.get("std") is None else float(entry["std"])
+        except (ThermalError, TypeError, KeyError, ValueError):
+            raise ThermalModelFileError(
+                src, f"coefficients.{name}", f"bad entry {entry!r}"
+            ) from None
+        if not math.isfinite(coefficients[name]):
+            raise ThermalModelFileError(src, f"coefficients.{name}", "value must be finite")
+    return ThermalModel(
+        table=table,
+        spec=spec,
+        coefficients=coefficients,
+        std=std,
+        refused={str(k): str(v) for k, v in dict(doc.get("refused", {})).items()},
+        robot_model=str(doc.get("robot_model", "")),
+        T_cell_base=_pose(doc, "T_cell_base", src),
+        T_tool0_tcp=_pose(doc, "T_tool0_tcp", src),
+        fit={str(k): float(v) for k, v in dict(doc.get("fit", {})).items() if v is not None},
+    )
+
+
+def load_model(path: str | Path) -> ThermalModel:
+    """Read ``thermal.json``; a missing file, bad JSON or a bad field raises a clear error."""
+    p = Path(path)
+    if not p.is_file():
+        raise ThermalModelFileError(str(path), "file", "no such file")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ThermalModelFileError(str(path), "file", f"not valid JSON ({exc})") from None
+    return model_from_dict(doc, str(path))
