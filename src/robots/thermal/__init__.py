@@ -39,6 +39,7 @@ from robots.thermal.identify import (
     IdentificationResult,
     IdentifyOptions,
     identify,
+    plan_report,
     reference_from_cold,
 )
 from robots.thermal.model import ThermalModel, ThermalSpec
@@ -69,6 +70,7 @@ __all__ = [
     "compensated_T_base_tcp",
     "default_settings",
     "identify",
+    "plan_report",
     "reference_from_cold",
     "simulate_observations",
     "solve_tcp",

@@ -296,3 +296,15 @@ def identify(
         dof=dof,
         timings={"identify_s": elapsed, "solver_nfev": float(sol.nfev)},
     )
+
+
+def plan_report(
+    obs: Observations,
+    geometry: CellGeometry,
+    table: DHTable,
+    spec: ThermalSpec,
+    options: IdentifyOptions | None = None,
+) -> IdentifiabilityReport:
+    """The rank/condition report of a pose plan without fitting (e.g. on simulated observations)."""
+    obs.check_targets(geometry)
+    return identifiability(_Problem(obs, geometry, table, spec), spec, options or IdentifyOptions())
