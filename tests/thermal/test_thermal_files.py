@@ -121,6 +121,8 @@ def test_poses_need_every_model_sensor(tmp_path):
     assert rows.temps_degC.tolist() == [[25.0]] and rows.rows[0][0] == "p1"
     with pytest.raises(ThermalDataError, match=r"missing temperature columns \['temp_j2_degC'\]"):
         read_poses(path, ("j1", "j2"))
+    partial = read_poses(path, ("j1", "j2"), used=("j1",))
+    assert partial.temps_degC[0, 0] == 25.0 and np.isnan(partial.temps_degC[0, 1])
 
 
 def test_model_file_round_trip_and_errors(tmp_path, table, cell, obs):

@@ -192,21 +192,31 @@ def write_observations(path: str | Path, obs: Observations) -> None:
             )
 
 
-def read_poses(path: str | Path, sensor_names: tuple[str, ...]) -> PoseRows:
-    """Read a poses CSV holding the joints and a temperature column for each of ``sensor_names``."""
+def read_poses(
+    path: str | Path, sensor_names: tuple[str, ...], used: tuple[str, ...] | None = None
+) -> PoseRows:
+    """Read a poses CSV: the joints and a temperature column for each sensor in ``used``.
+
+    ``used`` (default: all of ``sensor_names``) are the sensors the model reads; the
+    other sensors' temperatures are NaN when their column is absent.
+    """
     src = str(path)
     header, rows = _read(path)
     _check_units(src, header)
     _require(src, header, list(JOINT_COLUMNS))
     temp_cols = {n: (c, off) for c, n, off in _temperature_columns(header)}
-    missing = [f"temp_{n}_degC" for n in sensor_names if n not in temp_cols]
+    used = sensor_names if used is None else used
+    missing = [f"temp_{n}_degC" for n in used if n not in temp_cols]
     if missing:
         raise ThermalDataError(
             src, f"missing temperature columns {missing} (the model's sensors)", line=1
         )
     q = _floats(src, header, rows, list(JOINT_COLUMNS))
-    temps = _floats(src, header, rows, [temp_cols[n][0] for n in sensor_names])
-    temps = temps + np.array([temp_cols[n][1] for n in sensor_names])
+    temps = np.full((len(rows), len(sensor_names)), np.nan)
+    for j, n in enumerate(sensor_names):
+        if n in temp_cols:
+            col, offset = temp_cols[n]
+            temps[:, j] = _floats(src, header, rows, [col])[:, 0] + offset
     width = len(header)
     return PoseRows(
         q_rad=q,

@@ -1,0 +1,205 @@
+"""``holecell thermal``: identify the thermal error model, and predict compensated TCP positions.
+
+    holecell thermal identify OBS.csv --cell CELL -o thermal.json
+    holecell thermal predict thermal.json POSES.csv [-o OUT.csv] [--command]
+
+The CSV formats are described in :mod:`robots.thermal.csvio` and docs/thermal.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from robots.dh import DHTable, dh_table
+from robots.models import MODELS
+from robots.thermal import (
+    CellGeometry,
+    IdentificationResult,
+    IdentifyOptions,
+    ThermalSpec,
+    command,
+    identify,
+    reference_from_cold,
+)
+from robots.thermal.csvio import read_observations, read_poses
+from robots.thermal.modelfile import load_model, save_model
+
+PREDICT_COLUMNS = (
+    "tcp_x_cell_m",
+    "tcp_y_cell_m",
+    "tcp_z_cell_m",
+    "drift_x_m",
+    "drift_y_m",
+    "drift_z_m",
+    "drift_m",
+)
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``thermal identify`` and ``thermal predict``."""
+    p = subparsers.add_parser(
+        "thermal",
+        help="temperature error compensation: identify the model, predict compensated poses",
+        description="Temperature error compensation on the D-H model of the arm.",
+    )
+    sub = p.add_subparsers(dest="thermal_command", metavar="STEP")
+    p.set_defaults(handler=lambda args: _help(p))
+    ident = sub.add_parser(
+        "identify",
+        help="fit the thermal model to reference-target observations",
+        description="Reads OBS.csv (time_s, target_id, q1_rad..q6_rad, temp_<sensor>_degC, "
+        "x_tcp_m, y_tcp_m, z_tcp_m) and the cell file (reference targets, base and tool "
+        "poses); prints the coefficients, their uncertainty, the refused terms and the fit "
+        "residual; writes the model (thermal.json).",
+    )
+    ident.add_argument("observations", type=Path, metavar="OBS.csv")
+    ident.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
+    ident.add_argument("-o", "--output", type=Path, required=True, metavar="thermal.json")
+    ident.add_argument(
+        "--sensor-map",
+        metavar="S1,..,S6",
+        help="sensor driving each of the six links (default: one sensor drives all; six in order)",
+    )
+    ident.add_argument("--offsets", action="store_true", help="also fit joint-offset drift terms")
+    ident.add_argument(
+        "--max-condition",
+        type=float,
+        default=IdentifyOptions().max_condition,
+        help="refuse terms until the normalised Jacobian's condition number is below this "
+        "(default %(default)g)",
+    )
+    ident.set_defaults(handler=run_identify)
+    pred = sub.add_parser(
+        "predict",
+        help="compensated TCP positions for joint vectors and temperatures",
+        description="Reads thermal.json and POSES.csv (q1_rad..q6_rad and a temp_<sensor>_degC "
+        "column per model sensor; other columns are passed through); writes the compensated "
+        "TCP position in the cell frame and its drift from the nominal (m), as CSV.",
+    )
+    pred.add_argument("model", type=Path, metavar="thermal.json")
+    pred.add_argument("poses", type=Path, metavar="POSES.csv")
+    pred.add_argument("-o", "--output", type=Path, help="output CSV (default: standard output)")
+    pred.add_argument(
+        "--command",
+        action="store_true",
+        help="also give the joint vector that puts the warm TCP on its nominal pose (q*_cmd_rad)",
+    )
+    pred.set_defaults(handler=run_predict)
+
+
+def _help(parser: argparse.ArgumentParser) -> int:
+    parser.print_help()
+    return 2
+
+
+def _table_of(model_name: str) -> DHTable:
+    if model_name in MODELS:
+        return dh_table(model_name)
+    from robots import Arm
+
+    return Arm(model_name).dh
+
+
+def _geometry(cell_arg: str) -> tuple[CellGeometry, str, DHTable]:
+    from cell.config import load_cell
+    from cell.errors import ConfigError
+
+    cfg = load_cell(cell_arg)
+    if not cfg.reference_targets:
+        raise ConfigError(
+            str(cfg.source_path or cell_arg),
+            [("reference_targets", [], "the cell has no reference targets to identify from")],
+        )
+    targets = {t.id: np.asarray(t.position, float) for t in cfg.reference_targets}
+    geometry = CellGeometry(cfg.T_cell_base(), cfg.T_tool0_tcp(), targets)
+    return geometry, cfg.robot.model, _table_of(cfg.robot.model)
+
+
+def _print_result(res: IdentificationResult, source: Path) -> None:
+    m, rep = res.model, res.report
+    sensors = ", ".join(m.spec.sensor_names)
+    print(
+        f"thermal model from {source}: {res.n_rows} rows in {res.n_groups} pose groups, "
+        f"sensors {sensors}"
+    )
+    print(
+        f"rank {rep.rank} of {len(rep.candidates)} candidate terms; condition "
+        f"{rep.condition_kept:.3g} for the {len(rep.kept)} kept (all with an effect: "
+        f"{rep.condition_all:.3g})"
+    )
+    print(f"{'term':<10} {'value':>12} {'1-sigma':>12}  unit")
+    for name, value in m.coefficients.items():
+        unit = "1/K" if name.startswith("k_") else "rad/K"
+        print(f"{name:<10} {value:>12.4e} {m.std[name]:>12.2e}  {unit}")
+    for name, reason in rep.refused.items():
+        print(f"refused {name}: {reason}")
+    print(
+        f"fit residual RMS {res.residual_rms_m * 1e6:.2f} um (without the model "
+        f"{res.residual_rms_before_m * 1e6:.2f} um), noise estimate {res.sigma_m * 1e6:.2f} um, "
+        f"{res.timings['identify_s']:.3f} s"
+    )
+
+
+def _write_atomic(path: Path, write) -> None:
+    tmp = path.with_name(f".{path.name}.tmp")
+    write(tmp)
+    os.replace(tmp, path)
+
+
+def run_identify(args: argparse.Namespace) -> int:
+    """Identify the model from the observations and write thermal.json."""
+    geometry, model_name, table = _geometry(args.cell)
+    obs = read_observations(args.observations, known_targets=set(geometry.targets_cell_m))
+    link_sensors = None
+    if args.sensor_map:
+        link_sensors = tuple(s.strip() for s in args.sensor_map.split(","))
+    spec = ThermalSpec.mapped(
+        obs.sensor_names, reference_from_cold(obs), link_sensors, offsets=args.offsets
+    )
+    options = IdentifyOptions(max_condition=args.max_condition)
+    res = identify(obs, geometry, table, spec, options, robot_model=model_name)
+    _print_result(res, args.observations)
+    _write_atomic(args.output, lambda p: save_model(p, res.model))
+    print(f"wrote {args.output}")
+    return 0
+
+
+def run_predict(args: argparse.Namespace) -> int:
+    """Compensated TCP positions (and optionally commands) for every row of POSES.csv."""
+    model = load_model(args.model)
+    names = model.spec.sensor_names
+    used = tuple(dict.fromkeys(names[i] for i in model.spec.sensor_of_link))
+    poses = read_poses(args.poses, names, used)
+    T_cell_tcp = model.T_cell_base @ model.fk(poses.q_rad, poses.temps_degC) @ model.T_tool0_tcp
+    nominal = model.T_cell_base @ model.fk(
+        poses.q_rad, np.broadcast_to(model.spec.reference_degC, poses.temps_degC.shape)
+    )
+    p = T_cell_tcp[:, :3, 3]
+    drift = p - (nominal @ model.T_tool0_tcp)[:, :3, 3]
+    header = list(poses.header) + list(PREDICT_COLUMNS)
+    cmds = []
+    if args.command:
+        header += [f"q{i}_cmd_rad" for i in range(1, 7)] + ["command_status"]
+        cmds = [command(model, q, T) for q, T in zip(poses.q_rad, poses.temps_degC, strict=True)]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    for i, row in enumerate(poses.rows):
+        values = [*p[i], *drift[i], np.linalg.norm(drift[i])]
+        extra = [repr(float(v)) for v in values]
+        if cmds:
+            extra += [repr(float(v)) for v in cmds[i].q_rad] + [cmds[i].status]
+        w.writerow(list(row) + extra)
+    if args.output:
+        _write_atomic(args.output, lambda path: path.write_text(buf.getvalue(), encoding="utf-8"))
+        print(f"wrote {len(poses.rows)} rows to {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(buf.getvalue())
+    return 0 if all(c.ok for c in cmds) else 1
