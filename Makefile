@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/holecell demo
+	$(VENV)/bin/holecell cell show
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -3,7 +3,8 @@
 The shipped files ``robots/urdf/<model>.urdf`` are this writer's output; a
 test keeps them equal. Collision geometry is coarse primitives that enclose
 each real link with a margin (URDF has no capsule: cylinders, spheres and
-boxes only). Shapes are laid out in the cell at q = 0, where every link frame
+boxes only). The lower arm (link_2) sits beside the plane of the forearm, as
+on ABB's arms whose J3 folds the forearm back past it. Shapes are laid out in the cell at q = 0, where every link frame
 is axis-aligned with ``base_link``, and shifted into their link frames.
 
 Run ``python -m robots.urdf_writer`` to rewrite the shipped files.
@@ -65,8 +66,11 @@ def link_shapes(spec: ArmSpec) -> list[LinkShape]:
             (0.25 * s, turret_top - 0.2 * s),
             (0.0, 0.0, 0.5 * (turret_top + 0.2 * s)),
         ),
-        LinkShape("link_1", "box", (a1 + 0.34 * s, 0.46 * s, 0.26 * s), (0.5 * a1 - 0.05 * s, 0.0, d1)),
-        LinkShape("link_2", "cylinder", (0.13 * s, a2 + 0.26 * s), (a1, 0.0, d1 + 0.5 * a2)),
+        LinkShape(
+            "link_1", "box", (a1 + 0.34 * s, 0.62 * s, 0.26 * s), (0.5 * a1 - 0.05 * s, -0.08 * s, d1)
+        ),
+        # the lower arm runs beside the arm plane, so the forearm folds past it (J3 to -180 deg)
+        LinkShape("link_2", "cylinder", (0.12 * s, a2 + 0.26 * s), (a1, -0.23 * s, d1 + 0.5 * a2)),
         LinkShape(
             "link_3",
             "box",

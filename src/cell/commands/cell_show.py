@@ -1,0 +1,81 @@
+"""``holecell cell show [CELL]``: summary of a cell file and the reach of every hole."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+
+from cell.config import CellConfig, load_cell
+from cell.errors import CellError
+from cell.reach import hole_reach
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``cell`` with its ``show`` subcommand."""
+    cell = sub.add_parser("cell", help="inspect a cell file", description="Inspect a cell file.")
+    cell_sub = cell.add_subparsers(dest="cell_command", metavar="ACTION")
+    show = cell_sub.add_parser(
+        "show",
+        help="summarise a cell and the reach of each hole",
+        description=(
+            "Reads CELL (a cell.yaml; default: the built-in motorcycle frame) and prints the robot, "
+            "tool, part, obstacles and, for each hole, how many IK solutions of its nominal "
+            "viewpoint (roll about the view axis sampled) are within limits and collision-free. "
+            "Writes nothing."
+        ),
+    )
+    show.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
+    show.add_argument("--roll-step-deg", type=float, default=15.0, help="roll sampling (deg)")
+    show.set_defaults(handler=run_show)
+    cell.set_defaults(handler=lambda args: (cell.print_help(), 2)[1])
+
+
+def _summary(cfg: CellConfig) -> list[str]:
+    arm = cfg.build_arm()
+    base = cfg.robot.base
+    lines = [
+        f"cell      {cfg.name}  ({cfg.source_path})",
+        f"robot     {arm.name}  base xyz {base.xyz}  home {np.round(cfg.home_q(), 4).tolist()} rad",
+        "          limits  vel "
+        + " ".join(f"{v:.2f}" for v in arm.velocity_limit)
+        + " rad/s",
+        f"tool      tcp {cfg.tool.tool0_to_tcp.xyz} from tool0, standoff {cfg.tool.standoff_m} m, "
+        f"{len(cfg.tool.shapes)} shapes",
+        f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes, "
+        f"{len(cfg.part.obstacles)} obstacles",
+        f"cell      {len(cfg.environment.obstacles)} environment obstacles, "
+        f"{len(cfg.reference_targets)} reference targets",
+    ]
+    if arm.collision.excluded_pairs:
+        lines.append(f"note      pairs touching at q=0, not checked: {arm.collision.excluded_pairs}")
+    return lines
+
+
+def run_show(args: argparse.Namespace) -> int:
+    """Print the summary and the per-hole reach table; exit 1 when a hole is unreachable."""
+    cfg = load_cell(args.cell)
+    if args.roll_step_deg <= 0 or args.roll_step_deg > 360:
+        raise CellError(f"--roll-step-deg must be in (0, 360], got {args.roll_step_deg}")
+    print("\n".join(_summary(cfg)))
+    arm = cfg.build_arm()
+    step = math.radians(args.roll_step_deg)
+    print(f"\n{'hole':8s} {'diam mm':>8s} {'IK sols':>8s} {'free':>6s} {'rolls ok':>9s}  note")
+    unreachable = 0
+    rows = [(h.id, h.diameter_m, h.position_m, h.normal) for h in cfg.holes_in_cell()]
+    rows += [
+        (f"{t.id}*", t.diameter, np.array(t.position), np.array(t.normal)) for t in cfg.reference_targets
+    ]
+    for hid, diameter, position, normal in rows:
+        r = hole_reach(arm, hid, position, normal, cfg.tool.standoff_m, step)
+        unreachable += not r.reachable
+        note = "" if r.reachable else f"UNREACHABLE: {r.reason}"
+        if r.reachable and r.rolls_free < r.n_rolls // 4:
+            note = "hard: few rolls usable"
+        print(
+            f"{hid:8s} {diameter * 1e3:8.1f} {r.n_solutions:8d} {r.n_free:6d} "
+            f"{r.rolls_free:4d}/{r.n_rolls:<4d}  {note}"
+        )
+    print(f"\n* reference target.  {len(rows) - unreachable} of {len(rows)} reachable.")
+    return 1 if unreachable else 0

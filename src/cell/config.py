@@ -1,0 +1,347 @@
+"""The cell file (``cell.yaml``): robot, stereo head, part with holes, obstacles, reference targets.
+
+Every length is in metres, every angle in radians. Poses are
+``{xyz: [...], rpy: [...]}`` or ``{xyz: [...], quat_xyzw: [...]}``. The part's
+holes and obstacles are given in the part frame, placed in the cell by
+``part.base``; environment obstacles and reference targets are in the cell
+frame. :func:`load_cell` validates the whole file and reports every problem
+with the file name, the field path and the value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator
+
+from cell.errors import ConfigError
+from robots import DEFAULT_MODEL, Arm, LimitScaling, RobotModelError, Shape
+from robots.transforms import pose_to_matrix
+
+DATA_DIR = Path(__file__).parent / "data"
+BUILTIN_CELLS = ("motorcycle_frame",)
+#: a normal whose length differs from 1 by more than this is an error
+UNIT_TOL = 1e-3
+
+Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Positive = Annotated[float, Field(gt=0)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Pose(_Strict):
+    """A pose: position (m) and either roll-pitch-yaw (rad) or a quaternion [x, y, z, w]."""
+
+    xyz: Vec3
+    rpy: Vec3 | None = None
+    quat_xyzw: Annotated[list[float], Field(min_length=4, max_length=4)] | None = None
+
+    @field_validator("quat_xyzw")
+    @classmethod
+    def _unit_quaternion(cls, q: list[float] | None) -> list[float] | None:
+        if q is not None and abs(np.linalg.norm(q) - 1.0) > UNIT_TOL:
+            raise ValueError("quaternion must have unit length")
+        return q
+
+    def model_post_init(self, __context: Any) -> None:
+        if self.rpy is not None and self.quat_xyzw is not None:
+            raise ValueError("give either rpy or quat_xyzw, not both")
+
+    def matrix(self) -> np.ndarray:
+        """The 4x4 transform of this pose."""
+        return pose_to_matrix(self.xyz, self.rpy, self.quat_xyzw)
+
+
+IDENTITY = Pose(xyz=[0.0, 0.0, 0.0], rpy=[0.0, 0.0, 0.0])
+
+
+def _unit(v: list[float]) -> list[float]:
+    n = float(np.linalg.norm(v))
+    if n == 0.0 or not np.isfinite(n):
+        raise ValueError("normal must be a non-zero vector")
+    if abs(n - 1.0) > UNIT_TOL:
+        raise ValueError(f"normal must have unit length (length {n:.6g})")
+    return [float(x) / n for x in v]
+
+
+class Box(_Strict):
+    size: Annotated[list[Positive], Field(min_length=3, max_length=3)]
+
+
+class Cylinder(_Strict):
+    radius: Positive
+    length: Positive
+
+
+class Sphere(_Strict):
+    radius: Positive
+
+
+class ShapeSpec(_Strict):
+    """One primitive: exactly one of ``box``, ``cylinder``, ``capsule``, ``sphere``, with a pose."""
+
+    box: Box | None = None
+    cylinder: Cylinder | None = None
+    capsule: Cylinder | None = None
+    sphere: Sphere | None = None
+    pose: Pose = IDENTITY
+    name: str | None = None
+
+    def model_post_init(self, __context: Any) -> None:
+        kinds = [k for k in ("box", "cylinder", "capsule", "sphere") if getattr(self, k) is not None]
+        if len(kinds) != 1:
+            raise ValueError(f"a shape needs exactly one of box, cylinder, capsule, sphere (got {kinds})")
+
+    def to_shape(self, T_parent: np.ndarray, default_name: str) -> Shape:
+        """The :class:`robots.Shape`, its pose premultiplied by ``T_parent``."""
+        name = self.name or default_name
+        T = T_parent @ self.pose.matrix()
+        if self.box is not None:
+            return Shape("box", tuple(self.box.size), T, name)
+        if self.sphere is not None:
+            return Shape("sphere", (self.sphere.radius,), T, name)
+        kind = "cylinder" if self.cylinder is not None else "capsule"
+        dims = self.cylinder or self.capsule
+        return Shape(kind, (dims.radius, dims.length), T, name)
+
+
+class Limits(_Strict):
+    velocity_scale: Annotated[float, Field(gt=0, le=1)] = 1.0
+    acceleration_scale: Annotated[float, Field(gt=0, le=1)] = 1.0
+    jerk_scale: Annotated[float, Field(gt=0, le=1)] = 1.0
+
+
+class Robot(_Strict):
+    model: str = DEFAULT_MODEL
+    base: Pose = IDENTITY
+    home: Annotated[list[float], Field(min_length=6, max_length=6)]
+    limits: Limits = Limits()
+
+
+class Tool(_Strict):
+    tool0_to_tcp: Pose
+    standoff_m: Positive
+    shapes: list[ShapeSpec] = []
+    calibration: str | None = None
+
+
+class Hole(_Strict):
+    id: Annotated[str, Field(min_length=1)]
+    position: Vec3
+    normal: Vec3
+    diameter: Positive
+    tolerance: Positive | None = None
+
+    _unit_normal = field_validator("normal")(lambda cls, v: _unit(v))
+
+
+class Part(_Strict):
+    base: Pose = IDENTITY
+    holes: list[Hole] = []
+    obstacles: list[ShapeSpec] = []
+
+
+class Environment(_Strict):
+    obstacles: list[ShapeSpec] = []
+
+
+class ReferenceTarget(_Strict):
+    id: Annotated[str, Field(min_length=1)]
+    position: Vec3
+    normal: Vec3
+    diameter: Positive
+
+    _unit_normal = field_validator("normal")(lambda cls, v: _unit(v))
+
+
+@dataclass(frozen=True)
+class HoleInCell:
+    """A hole in the cell frame: centre (m), unit normal out of the surface, diameter (m)."""
+
+    id: str
+    position_m: np.ndarray
+    normal: np.ndarray
+    diameter_m: float
+    tolerance_m: float | None
+
+
+class CellConfig(_Strict):
+    """A whole cell file. Build it with :func:`load_cell`."""
+
+    name: Annotated[str, Field(min_length=1)]
+    robot: Robot
+    tool: Tool
+    part: Part
+    environment: Environment = Environment()
+    reference_targets: list[ReferenceTarget] = []
+
+    _source_path: Path | None = PrivateAttr(default=None)
+    _raw_text: str = PrivateAttr(default="")
+
+    @property
+    def source_path(self) -> Path | None:
+        """The file this cell was read from."""
+        return self._source_path
+
+    @property
+    def raw_text(self) -> str:
+        """The YAML text as read (stored with every run)."""
+        return self._raw_text
+
+    def T_cell_base(self) -> np.ndarray:
+        """Pose of the robot's ``base_link`` in the cell frame."""
+        return self.robot.base.matrix()
+
+    def T_cell_part(self) -> np.ndarray:
+        """Pose of the part frame in the cell frame."""
+        return self.part.base.matrix()
+
+    def T_tool0_tcp(self) -> np.ndarray:
+        """Pose of the TCP (the stereo head's view frame) relative to ``tool0``."""
+        return self.tool.tool0_to_tcp.matrix()
+
+    def home_q(self) -> np.ndarray:
+        """The home joint vector (rad)."""
+        return np.array(self.robot.home, dtype=float)
+
+    def holes_in_cell(self) -> list[HoleInCell]:
+        """Every hole with its centre and normal in the cell frame."""
+        T = self.T_cell_part()
+        return [
+            HoleInCell(
+                id=h.id,
+                position_m=T[:3, :3] @ np.array(h.position) + T[:3, 3],
+                normal=T[:3, :3] @ np.array(h.normal),
+                diameter_m=h.diameter,
+                tolerance_m=h.tolerance,
+            )
+            for h in self.part.holes
+        ]
+
+    def tool_shapes(self) -> list[Shape]:
+        """The stereo head's shapes, poses relative to ``tool0``."""
+        return [s.to_shape(np.eye(4), f"tool{i}") for i, s in enumerate(self.tool.shapes)]
+
+    def obstacle_shapes(self) -> list[Shape]:
+        """Part and environment obstacles, poses in the cell frame."""
+        T_part = self.T_cell_part()
+        part = [s.to_shape(T_part, f"part{i}") for i, s in enumerate(self.part.obstacles)]
+        env = [s.to_shape(np.eye(4), f"env{i}") for i, s in enumerate(self.environment.obstacles)]
+        return part + env
+
+    def build_arm(self) -> Arm:
+        """The arm with its base pose, limit scaling, tool and every obstacle attached."""
+        lim = self.robot.limits
+        scaling = LimitScaling(lim.velocity_scale, lim.acceleration_scale, lim.jerk_scale)
+        model = self.robot.model
+        if self._source_path is not None and model.endswith(".urdf"):
+            model = str((self._source_path.parent / model).resolve())
+        arm = Arm(model, T_cell_base=self.T_cell_base(), scaling=scaling)
+        arm.set_tool(self.T_tool0_tcp(), self.tool_shapes())
+        arm.add_obstacles(self.obstacle_shapes())
+        return arm
+
+    def calibration_path(self) -> Path | None:
+        """The stereo calibration file, resolved against the cell file's folder."""
+        if self.tool.calibration is None:
+            return None
+        path = Path(self.tool.calibration)
+        if not path.is_absolute() and self._source_path is not None:
+            path = self._source_path.parent / path
+        return path
+
+
+def _field_path(loc: tuple[Any, ...]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in ("function-after[_unit(), list[float]]",):
+            continue
+        else:
+            out += f".{part}" if out else str(part)
+    return out or "(top level)"
+
+
+def _pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
+    problems = []
+    for err in exc.errors():
+        msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key"
+        problems.append((_field_path(err["loc"]), err.get("input"), msg))
+    return problems
+
+
+def _duplicate_ids(cfg: CellConfig) -> list[tuple[str, object, str]]:
+    problems = []
+    for group, items in (("part.holes", cfg.part.holes), ("reference_targets", cfg.reference_targets)):
+        seen: set[str] = set()
+        for i, item in enumerate(items):
+            if item.id in seen:
+                problems.append((f"{group}[{i}].id", item.id, "duplicate id"))
+            seen.add(item.id)
+    return problems
+
+
+def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
+    try:
+        arm = cfg.build_arm()
+    except RobotModelError as exc:
+        return [("robot.model", cfg.robot.model, str(exc))]
+    q = cfg.home_q()
+    if not arm.within_limits(q):
+        bad = [arm.joint_names[i] for i in range(6) if not arm.lower[i] <= q[i] <= arm.upper[i]]
+        return [("robot.home", cfg.robot.home, f"outside the joint limits of {arm.name} ({', '.join(bad)})")]
+    if arm.in_collision(q):
+        pairs = ", ".join(f"{a} / {b}" for a, b in arm.colliding_pairs(q)[:3])
+        return [("robot.home", cfg.robot.home, f"in collision ({pairs})")]
+    return []
+
+
+def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = None) -> CellConfig:
+    """Validate a cell file's YAML text; raises :class:`ConfigError` listing every problem."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(source, [("(yaml)", None, f"not valid YAML: {exc}")]) from exc
+    if not isinstance(data, dict):
+        raise ConfigError(source, [("(top level)", data, "a cell file is a mapping of keys")])
+    try:
+        cfg = CellConfig.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError(source, _pydantic_problems(exc)) from exc
+    cfg._source_path = source_path
+    cfg._raw_text = text
+    problems = _duplicate_ids(cfg) or _robot_problems(cfg)
+    if problems:
+        raise ConfigError(source, problems)
+    return cfg
+
+
+def builtin_cell_path(name: str = "motorcycle_frame") -> Path:
+    """Path of a cell file shipped with the package."""
+    if name not in BUILTIN_CELLS:
+        raise ConfigError(name, [("(name)", name, f"no built-in cell (known: {', '.join(BUILTIN_CELLS)})")])
+    return DATA_DIR / f"{name}.yaml"
+
+
+def load_cell(path: str | Path | None = None) -> CellConfig:
+    """Read and validate a cell file; ``None`` or a built-in name gives a built-in cell."""
+    if path is None or str(path) in BUILTIN_CELLS:
+        path = builtin_cell_path(str(path) if path else "motorcycle_frame")
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(str(path), [("(file)", str(path), "no such file")])
+    return parse_cell(path.read_text(), str(path), path.resolve())
+
+
+def load_builtin_cell(name: str = "motorcycle_frame") -> CellConfig:
+    """The built-in cell ``name``."""
+    return load_cell(builtin_cell_path(name))
