@@ -1,0 +1,145 @@
+"""The closed hole contour of one image: lines through the centroid, gap filling, ellipse.
+
+Sub-pixel edge points are expressed in polar form ``r(θ)`` about the region centroid. A
+bundle of lines through the centroid (about one per pixel of arc) cuts the contour at two
+points each (angles θ and θ + π), by linear interpolation along the contour. Where no edge
+point lies near a line (a broken edge) the point is *filled*: short gaps by interpolation
+along the contour, long gaps from a robust ellipse fitted to the rest. Points far from
+that ellipse (burrs, false edges) are treated as missing too.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+#: ``cv2.fitEllipse`` style: ((cx, cy), (full axis 1, full axis 2), angle in degrees)
+Ellipse = tuple[tuple[float, float], tuple[float, float], float]
+
+
+@dataclass(frozen=True)
+class Contour:
+    """Contour samples ordered by angle about the centroid (full-image pixels).
+
+    ``filled`` marks samples interpolated over a gap; ``long_gap`` those filled from the
+    ellipse over a long gap (they carry no measurement); ``ellipse`` is the robust
+    image ellipse of the measured samples.
+    """
+
+    points_px: np.ndarray
+    angles: np.ndarray
+    filled: np.ndarray
+    long_gap: np.ndarray
+    ellipse: Ellipse
+    n_outliers: int
+
+
+def ellipse_distance(pts: np.ndarray, ell: Ellipse) -> np.ndarray:
+    """Approximate signed distance (px) of points from an ellipse (radial, normalised)."""
+    (cx, cy), (a2, b2), ang = ell
+    t = np.deg2rad(ang)
+    d = pts - (cx, cy)
+    u = d[:, 0] * np.cos(t) + d[:, 1] * np.sin(t)
+    v = -d[:, 0] * np.sin(t) + d[:, 1] * np.cos(t)
+    a, b = a2 / 2.0, b2 / 2.0
+    rel = np.hypot(u / a, v / b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rad = np.hypot(u, v) / np.maximum(rel, 1e-12)  # ellipse radius along the ray
+    return (rel - 1.0) * rad
+
+
+def robust_ellipse(pts: np.ndarray, iterations: int = 4) -> tuple[Ellipse, np.ndarray]:
+    """``cv2.fitEllipse`` with iterative rejection (MAD, floor 0.5 px); returns the inlier mask."""
+    inl = np.ones(len(pts), dtype=bool)
+    ell = cv2.fitEllipse(pts.astype(np.float32))
+    for _ in range(iterations):
+        d = ellipse_distance(pts, ell)
+        mad = 1.4826 * float(np.median(np.abs(d[inl] - np.median(d[inl]))))
+        new = np.abs(d) < max(4.0 * mad, 0.5)
+        if new.sum() < 6 or np.array_equal(new, inl):
+            inl = new if new.sum() >= 6 else inl
+            break
+        inl = new
+        ell = cv2.fitEllipse(pts[inl].astype(np.float32))
+    ell = (
+        (float(ell[0][0]), float(ell[0][1])),
+        (float(ell[1][0]), float(ell[1][1])),
+        float(ell[2]),
+    )
+    return ell, inl
+
+
+def _ellipse_points(ell: Ellipse, centroid: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Where rays from ``centroid`` at ``angles`` meet the ellipse."""
+    (cx, cy), (a2, b2), ang = ell
+    t = np.deg2rad(ang)
+    a, b = a2 / 2.0, b2 / 2.0
+    c = np.array([np.cos(t), np.sin(t)])
+    s = np.array([-np.sin(t), np.cos(t)])
+    p0 = centroid - (cx, cy)
+    u0, v0 = p0 @ c, p0 @ s
+    dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    du, dv = dirs @ c, dirs @ s
+    A = (du / a) ** 2 + (dv / b) ** 2
+    B = 2 * (u0 * du / a**2 + v0 * dv / b**2)
+    C = (u0 / a) ** 2 + (v0 / b) ** 2 - 1.0
+    t_hit = (-B + np.sqrt(np.maximum(B * B - 4 * A * C, 0.0))) / (2 * A)
+    return centroid + t_hit[:, None] * dirs
+
+
+def _polar_clean(r: np.ndarray, window: int = 9) -> np.ndarray:
+    """Mask of samples within 1 px of a running median of r (sorted by angle, periodic)."""
+    n = len(r)
+    if n < window:
+        return np.ones(n, dtype=bool)
+    half = window // 2
+    idx = (np.arange(n)[:, None] + np.arange(-half, half + 1)[None, :]) % n
+    med = np.median(r[idx], axis=1)
+    return np.abs(r - med) < 1.0
+
+
+def build_contour(
+    edge_px: np.ndarray,
+    centroid_px: tuple[float, float],
+    arc_step_px: float = 1.0,
+    short_gap_px: float = 4.0,
+    max_points: int = 2048,
+) -> Contour | None:
+    """Resample edge points along lines through the centroid; fill gaps; fit the ellipse."""
+    if len(edge_px) < 12:
+        return None
+    c = np.asarray(centroid_px, dtype=np.float64)
+    d = edge_px - c
+    theta = np.arctan2(d[:, 1], d[:, 0])
+    order = np.argsort(theta)
+    theta, r, pts = theta[order], np.hypot(d[:, 0], d[:, 1])[order], edge_px[order]
+    ok = _polar_clean(r)
+    theta, r, pts = theta[ok], r[ok], pts[ok]
+    if len(theta) < 12:
+        return None
+    ell, inl = robust_ellipse(pts)
+    n_out = int((~inl).sum())
+    theta, r = theta[inl], r[inl]
+    r_mean = float(np.mean(r))
+    n_lines = int(np.clip(round(np.pi * r_mean / arc_step_px), 24, max_points // 2))
+    ang = -np.pi + np.pi * np.arange(2 * n_lines) / n_lines
+    # angular distance from each line to the nearest measured sample (periodic)
+    j = np.searchsorted(theta, ang) % len(theta)
+    jm = (j - 1) % len(theta)
+    gap_a = np.abs(np.angle(np.exp(1j * (ang - theta[j]))))
+    gap_b = np.abs(np.angle(np.exp(1j * (ang - theta[jm]))))
+    span = np.abs(np.angle(np.exp(1j * (theta[j] - theta[jm])))) * r_mean  # bracketing gap, px
+    filled = span > short_gap_px * 0.5 + arc_step_px
+    long_gap = span > short_gap_px
+    near = np.minimum(gap_a, gap_b) * r_mean
+    filled &= near > 0.5 * arc_step_px
+    long_gap &= near > 0.5 * arc_step_px
+    r_int = np.interp(ang, theta, r, period=2 * np.pi)
+    out = c + r_int[:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    if long_gap.any():
+        out[long_gap] = _ellipse_points(ell, c, ang[long_gap])
+    return Contour(
+        points_px=out, angles=ang, filled=filled, long_gap=long_gap, ellipse=ell, n_outliers=n_out
+    )

@@ -1,0 +1,114 @@
+"""Options and result of a stereo hole measurement."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from measure.contour import Ellipse
+
+
+@dataclass(frozen=True)
+class MeasureOptions:
+    """How :func:`measure.measure_hole` works. Defaults are the benchmarked best method.
+
+    Attributes:
+        edge_method: ``"parabola"`` (Devernay gradient-maximum, default) or ``"linear"``
+            (published linear interpolation of gray values).
+        circle_cost: ``"orthogonal"`` (true orthogonal distance, default) or ``"published"``.
+        smoothing_sigma_px: Gaussian smoothing before the gradient (pixels).
+        arc_step_px: spacing of the lines through the centroid, in pixels of arc.
+        short_gap_px: gaps up to this length (px) are filled along the contour and used in
+            the fit; longer gaps are filled from the image ellipse, reported, not used.
+        use_long_fills: also fit points filled over long gaps (the published method does).
+        min_epipolar_angle_deg: drop contour samples whose tangent is closer than this to the
+            epipolar direction.
+        robust: robust circle fit with rejection (see :func:`measure.fit_circle_3d`).
+        size_tolerance: relative diameter deviation from ``expected_diameter_m`` that is an error.
+        suspect_fraction: status ``"suspect"`` when more than this fraction of the contour
+            was filled or rejected.
+    """
+
+    edge_method: str = "parabola"
+    circle_cost: str = "orthogonal"
+    smoothing_sigma_px: float = 1.0
+    arc_step_px: float = 1.0
+    short_gap_px: float = 4.0
+    use_long_fills: bool = False
+    min_epipolar_angle_deg: float = 20.0
+    robust: bool = True
+    size_tolerance: float = 0.2
+    suspect_fraction: float = 0.3
+
+    @classmethod
+    def published(cls) -> MeasureOptions:
+        """The published method: linear interpolation, published cost, all filled points used."""
+        return cls(edge_method="linear", circle_cost="published", use_long_fills=True)
+
+
+@dataclass(frozen=True)
+class HoleMeasurement:
+    """A measured hole, in the LEFT camera optical frame, SI units.
+
+    Attributes:
+        status: ``"ok"``, or ``"suspect"`` when much of the edge was filled or rejected.
+        center_m: circle centre (3,). normal: unit axis pointing toward the camera (3,).
+        radius_m: circle radius. rms_m: RMS orthogonal residual of the fitted 3-D points.
+        n_points / n_rejected / n_filled: 3-D points used by the fit, rejected as outliers,
+            and contour samples filled over broken edges (both images).
+        cov_center_radius: 4×4 covariance of (cx, cy, cz, r) from the fit (m²).
+        timings: seconds per stage; ``time_s`` the total.
+        edges_left_px / edges_right_px: contour samples (N, 2) in each image (distorted
+            pixels); ``filled_left`` / ``filled_right`` mark the filled ones.
+        ellipse_left / ellipse_right: robust image ellipses, ``cv2.fitEllipse`` style
+            ``((cx, cy), (axis1, axis2), angle_deg)`` with full axis lengths.
+        points_m: triangulated edge points (K, 3, left frame); ``inliers`` (K,) those kept.
+        roi_left / roi_right: the regions of interest used, ``(x, y, w, h)``.
+    """
+
+    status: str
+    center_m: np.ndarray
+    normal: np.ndarray
+    radius_m: float
+    rms_m: float
+    n_points: int
+    n_rejected: int
+    n_filled: int
+    cov_center_radius: np.ndarray
+    timings: dict[str, float]
+    time_s: float
+    edges_left_px: np.ndarray
+    edges_right_px: np.ndarray
+    filled_left: np.ndarray
+    filled_right: np.ndarray
+    ellipse_left: Ellipse
+    ellipse_right: Ellipse
+    points_m: np.ndarray
+    inliers: np.ndarray
+    roi_left: tuple[int, int, int, int]
+    roi_right: tuple[int, int, int, int]
+    options: MeasureOptions = field(default_factory=MeasureOptions)
+
+    @property
+    def diameter_m(self) -> float:
+        """Circle diameter (metres)."""
+        return 2.0 * self.radius_m
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (the ``holecell measure --json`` object, without images)."""
+        return {
+            "status": self.status,
+            "center_m": [float(v) for v in self.center_m],
+            "normal": [float(v) for v in self.normal],
+            "radius_m": float(self.radius_m),
+            "diameter_m": float(self.diameter_m),
+            "rms_m": float(self.rms_m),
+            "n_points": int(self.n_points),
+            "n_rejected": int(self.n_rejected),
+            "n_filled": int(self.n_filled),
+            "cov_center_radius_m2": self.cov_center_radius.tolist(),
+            "time_s": float(self.time_s),
+            "timings_s": {k: float(v) for k, v in self.timings.items()},
+        }
