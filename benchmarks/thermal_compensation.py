@@ -30,7 +30,6 @@ import time
 import numpy as np
 
 from robots.dh import DHTable, dh_table, fk_dh
-from robots.ik import solve_ik
 from robots.models import MODELS
 from robots.thermal import (
     CellGeometry,
@@ -45,7 +44,8 @@ from robots.thermal import (
     reference_from_cold,
     simulate_observations,
 )
-from robots.transforms import frame_from_z_axis, pose_to_matrix
+from robots.thermal.plan import ViewOptions, view_plan
+from robots.transforms import pose_to_matrix
 
 MODEL = "abb_irb2600_20_165"
 NOISE_M = 5e-6  # stereo head noise per axis (m), until the measurement benchmark gives a figure
@@ -62,27 +62,23 @@ TARGETS_CELL_M = {
 VIEWS = ((0.0, 0.0, 0.0), (0.45, 0.0, 1.2), (0.45, 2.2, -0.8))
 
 
-def _view_pose(target: np.ndarray, tilt: float, azimuth: float, roll: float) -> np.ndarray:
-    """``T_base_tcp`` of the camera looking at ``target`` (TCP z pointing into it)."""
-    az = np.arctan2(target[1], target[0]) + azimuth
-    down = np.array([np.sin(tilt) * np.cos(az), np.sin(tilt) * np.sin(az), -np.cos(tilt)])
-    return frame_from_z_axis(target, down, roll)
-
-
 def pose_plan(table: DHTable, views=VIEWS, targets=TARGETS_CELL_M) -> list[tuple[str, np.ndarray]]:
-    """(target id, joint vector) of every view, on the front/elbow-up branch nearest a rest pose."""
+    """(target id, joint vector) of every view (TCP on the target, normals up)."""
     spec = MODELS[MODEL]
-    lower, upper = np.array(spec.lower_rad), np.array(spec.upper_rad)
-    plan = []
-    for tid, p in targets.items():
-        for tilt, az, roll in views:
-            T_tool0 = _view_pose(p, tilt, az, roll) @ np.linalg.inv(T_TOOL0_TCP)
-            ik = solve_ik(table, T_tool0, lower, upper)
-            if not ik.ok:
-                raise RuntimeError(f"view of {tid} unreachable: {ik.reason}")
-            rest = np.array([np.arctan2(p[1], p[0]), 0.3, 0.0, 0.0, 1.0, 0.0])
-            plan.append((tid, ik.solutions[np.argmin(np.abs(ik.solutions - rest).sum(axis=1))]))
-    return plan
+    tilts, azimuths, rolls = zip(*views, strict=True)
+    plan = view_plan(
+        table,
+        spec.lower_rad,
+        spec.upper_rad,
+        np.eye(4),
+        T_TOOL0_TCP,
+        {tid: (p, (0.0, 0.0, 1.0)) for tid, p in targets.items()},
+        standoff_m=0.0,
+        options=ViewOptions(tilts, azimuths, rolls),
+    )
+    if plan.skipped:
+        raise RuntimeError(f"unreachable views: {plan.skipped}")
+    return plan.poses
 
 
 def eval_poses(table: DHTable, rng: np.random.Generator) -> np.ndarray:

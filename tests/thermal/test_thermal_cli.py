@@ -145,3 +145,38 @@ def test_missing_files_are_reported(files, capsys):
         ["thermal", "identify", str(files["obs"]), "--cell", "missing.yaml", "-o", "x.json"]
     )
     assert rc == 2 and "missing.yaml" in capsys.readouterr().err
+
+
+def test_simulate_identify_predict_on_the_builtin_cell(tmp_path, capsys):
+    obs, model, poses = tmp_path / "obs.csv", tmp_path / "thermal.json", tmp_path / "poses.csv"
+    rc = cli.main(["thermal", "simulate", "--cell", "motorcycle_frame", "-o", str(obs)])
+    assert rc == 0, capsys.readouterr().err
+    assert "observations" in capsys.readouterr().out
+    rc = cli.main(["thermal", "identify", str(obs), "--cell", "motorcycle_frame", "-o", str(model)])
+    out = capsys.readouterr().out
+    assert rc == 0 and "k_link4" in out
+    doc = json.loads(model.read_text())
+    assert doc["coefficients"]["k_link4"]["value"] == pytest.approx(23e-6, abs=3e-6)
+    assert doc["fit"]["residual_rms_m"] < 7e-6
+    header = [f"q{i}_rad" for i in range(1, 7)] + [f"temp_j{i}_degC" for i in range(1, 7)]
+    poses.write_text(",".join(header) + "\n" + ",".join(["0.2"] * 6 + ["30"] * 6) + "\n")
+    rc = cli.main(["thermal", "predict", str(model), str(poses)])
+    rows = list(csv.DictReader(capsys.readouterr().out.splitlines()))
+    assert rc == 0 and len(rows) == 1
+    assert 1e-4 < float(rows[0]["drift_m"]) < 1e-3
+
+
+def test_simulate_refuses_bad_settings(tmp_path, capsys):
+    rc = cli.main(
+        [
+            "thermal",
+            "simulate",
+            "--cell",
+            "motorcycle_frame",
+            "-o",
+            str(tmp_path / "o.csv"),
+            "--every-s",
+            "0",
+        ]
+    )
+    assert rc == 2 and "positive duration" in capsys.readouterr().err

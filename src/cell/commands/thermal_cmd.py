@@ -2,6 +2,7 @@
 
     holecell thermal identify OBS.csv --cell CELL -o thermal.json
     holecell thermal predict thermal.json POSES.csv [-o OUT.csv] [--command]
+    holecell thermal simulate --cell CELL -o OBS.csv   (warm-up observations of a simulated arm)
 
 The CSV formats are described in :mod:`robots.thermal.csvio` and docs/thermal.md.
 """
@@ -21,15 +22,19 @@ from robots.dh import DHTable, dh_table
 from robots.models import MODELS
 from robots.thermal import (
     CellGeometry,
+    DriftTruth,
     IdentificationResult,
     IdentifyOptions,
     ThermalSpec,
     command,
+    default_settings,
     identify,
     reference_from_cold,
+    simulate_observations,
 )
-from robots.thermal.csvio import read_observations, read_poses
+from robots.thermal.csvio import read_observations, read_poses, write_observations
 from robots.thermal.modelfile import load_model, save_model
+from robots.thermal.plan import view_plan
 
 PREDICT_COLUMNS = (
     "tcp_x_cell_m",
@@ -92,6 +97,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="also give the joint vector that puts the warm TCP on its nominal pose (q*_cmd_rad)",
     )
     pred.set_defaults(handler=run_predict)
+    sim = sub.add_parser(
+        "simulate",
+        help="observations of the cell's reference targets on a simulated warming arm",
+        description="Plans three views of every reference target of the cell (IK, collision "
+        "checked), simulates the reference warm-up (robots.thermal.default_settings: about "
+        "+15 K in two hours) and writes the observations CSV that 'thermal identify' reads.",
+    )
+    sim.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
+    sim.add_argument("-o", "--output", type=Path, required=True, metavar="OBS.csv")
+    sim.add_argument("--hours", type=float, default=2.0, help="warm-up duration (default 2)")
+    sim.add_argument("--every-s", type=float, default=300.0, help="period (s, default 300)")
+    sim.add_argument("--noise-um", type=float, default=5.0, help="noise per axis (um, default 5)")
+    sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    sim.set_defaults(handler=run_simulate)
 
 
 def _help(parser: argparse.ArgumentParser) -> int:
@@ -203,3 +222,55 @@ def run_predict(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(buf.getvalue())
     return 0 if all(c.ok for c in cmds) else 1
+
+
+def run_simulate(args: argparse.Namespace) -> int:
+    """Simulated warm-up observations of the cell's reference targets."""
+    from cell.config import load_cell
+    from cell.errors import ConfigError
+
+    if args.hours <= 0 or args.every_s <= 0 or args.noise_um < 0:
+        raise ConfigError(
+            "holecell thermal simulate",
+            [
+                (
+                    "--hours/--every-s/--noise-um",
+                    (args.hours, args.every_s, args.noise_um),
+                    "need a positive duration and period and a non-negative noise",
+                )
+            ],
+        )
+    geometry, _, table = _geometry(args.cell)
+    cfg = load_cell(args.cell)
+    arm = cfg.build_arm()
+    targets = {t.id: (t.position, t.normal) for t in cfg.reference_targets}
+    plan = view_plan(
+        table,
+        arm.lower,
+        arm.upper,
+        geometry.T_cell_base,
+        geometry.T_tool0_tcp,
+        targets,
+        cfg.tool.standoff_m,
+        accept=lambda q: not arm.in_collision(q),
+    )
+    for tid, k, reason in plan.skipped:
+        print(f"view {k} of {tid} skipped: {reason}", file=sys.stderr)
+    truth = DriftTruth(table, default_settings(), seed=args.seed)
+    times = np.arange(0.0, args.hours * 3600.0 + 1e-9, args.every_s)
+    obs = simulate_observations(
+        truth.T_base_tool0,
+        truth.sensor_readings,
+        truth.settings.sensor_names,
+        geometry,
+        plan.poses,
+        times,
+        noise_m=args.noise_um * 1e-6,
+        seed=args.seed,
+    )
+    _write_atomic(args.output, lambda p: write_observations(p, obs))
+    print(
+        f"wrote {len(obs)} observations ({len(plan.poses)} poses x {len(times)} times) "
+        f"to {args.output}"
+    )
+    return 0

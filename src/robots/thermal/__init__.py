@@ -8,6 +8,7 @@
 - :mod:`~robots.thermal.compensate`: the measurement transform and the command at one pose.
 - :mod:`~robots.thermal.drift`: the drift generator (hidden truth for simulation and tests).
 - :mod:`~robots.thermal.observations`: observation sets, cell geometry, simulated observations.
+- :mod:`~robots.thermal.plan`: viewing poses of the reference targets (the pose plan).
 - :mod:`~robots.thermal.csvio`, :mod:`~robots.thermal.modelfile`: CSV formats, thermal.json.
 """
 
@@ -44,6 +45,7 @@ from robots.thermal.identify import (
 )
 from robots.thermal.model import ThermalModel, ThermalSpec
 from robots.thermal.observations import CellGeometry, Observations, simulate_observations
+from robots.thermal.plan import ViewOptions, ViewPlan, view_plan, view_pose
 
 __all__ = [
     "MATERIAL_EXPANSION_PER_K",
@@ -64,6 +66,8 @@ __all__ = [
     "ThermalSpec",
     "ThermalSpecError",
     "UnidentifiableError",
+    "ViewOptions",
+    "ViewPlan",
     "WarmUp",
     "camera_to_part",
     "command",
@@ -74,4 +78,6 @@ __all__ = [
     "reference_from_cold",
     "simulate_observations",
     "solve_tcp",
+    "view_plan",
+    "view_pose",
 ]
