@@ -248,6 +248,10 @@ def _validate(cal: StereoCalibration) -> None:
         or np.linalg.det(cal.R) < 0
     ):
         raise CalibrationError(src, "R", "not a rotation matrix")
+    if abs(cal.T[0]) < abs(cal.T[1]):
+        raise CalibrationError(
+            src, "T", f"the cameras must sit side by side (|Tx| > |Ty|), got {cal.T.tolist()}"
+        )
     if not math.isfinite(cal.baseline_m) or cal.baseline_m <= 1e-6:
         raise CalibrationError(
             src, "T", f"baseline must be positive (metres), got {cal.T.tolist()}"

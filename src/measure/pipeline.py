@@ -136,12 +136,12 @@ def measure_hole(
     t0 = time.perf_counter()
     if np.shape(left) != np.shape(right):
         raise ImageError("pair", f"left is {np.shape(left)} but right is {np.shape(right)} (h, w)")
-    full_l = check_image(left, "left")
-    full_r = check_image(right, "right")
+    full_l, small_l = check_image(left, "left")
+    full_r, small_r = check_image(right, "right")
     stereo.check_image(left.shape, "left")
     roi_l, roi_r = _rois(roi)
-    cand_l = _usable(find_candidates(left, full_l, roi_l), "left", roi_l, left.shape)
-    cand_r = _usable(find_candidates(right, full_r, roi_r), "right", roi_r, right.shape)
+    cand_l = _usable(find_candidates(small_l, roi_l), "left", roi_l, left.shape)
+    cand_r = _usable(find_candidates(small_r, roi_r), "right", roi_r, right.shape)
     cl, cr = _pick_pair(cand_l, cand_r, stereo, expected_diameter_m, opts.size_tolerance)
     t["detect"] = time.perf_counter() - t0
 
