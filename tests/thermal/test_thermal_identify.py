@@ -7,8 +7,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from robots.dh import fk_dh
 from robots.thermal import (
+    CellGeometry,
     DriftTruth,
+    ThermalDataError,
     ThermalSpec,
     UnidentifiableError,
     default_settings,
@@ -17,6 +20,7 @@ from robots.thermal import (
     simulate_observations,
 )
 from robots.thermal.drift import DriftSettings, WarmUp
+from robots.transforms import pose_to_matrix
 
 TIMES = np.arange(0.0, 7201.0, 600.0)
 
@@ -111,3 +115,30 @@ def test_constant_sensor_and_single_time_are_refused(table, cell):
     once = _observe(warm, cell, times=np.array([600.0]))
     with pytest.raises(UnidentifiableError):
         identify(once, cell[0], table, ThermalSpec.mapped(once.sensor_names, (20.0,) * 6))
+
+
+def test_joint6_offset_is_invisible_with_the_target_on_the_j6_axis(table):
+    """A TCP on the flange axis and targets at the TCP: a J6 offset drift moves nothing measured."""
+    T_tool0_tcp = pose_to_matrix([0.0, 0.0, 0.3])
+    qs = [
+        (0.0, 0.3, -0.2, 0.5, 0.8, 0.1),
+        (0.6, 0.1, 0.2, -0.5, 1.0, 0.3),
+        (-0.7, 0.5, -0.4, 0.2, -0.9, -0.2),
+    ]
+    plan = [(f"T{i}", np.asarray(q)) for i, q in enumerate(qs)]
+    targets = {tid: (fk_dh(table, q) @ T_tool0_tcp)[:3, 3] for tid, q in plan}
+    geometry = CellGeometry(np.eye(4), T_tool0_tcp, targets)
+    truth = DriftTruth(table, default_settings(per_joint_noise_K=0.0))
+    obs = _observe(truth, (geometry, plan))
+    spec = ThermalSpec.mapped(obs.sensor_names, reference_from_cold(obs), offsets=True)
+    res = identify(obs, geometry, table, spec)
+    assert "no measurable effect" in res.report.refused["c_joint6"]
+    assert "c_joint5" in res.report.kept
+
+
+def test_sensor_names_must_match_the_spec(table, cell):
+    truth = DriftTruth(table, default_settings(per_joint_noise_K=0.0))
+    obs = _observe(truth, cell)
+    spec = ThermalSpec.mapped(("amb",), (20.0,))
+    with pytest.raises(ThermalDataError, match="the model expects"):
+        identify(obs, cell[0], table, spec)

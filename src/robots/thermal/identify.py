@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from robots.dh import DHTable
-from robots.thermal.errors import UnidentifiableError
+from robots.thermal.errors import ThermalDataError, UnidentifiableError
 from robots.thermal.model import (
     TERM_SCALE,
     ThermalModel,
@@ -219,6 +219,18 @@ def identifiability(
     )
 
 
+def _check_inputs(obs: Observations, geometry: CellGeometry, spec: ThermalSpec) -> None:
+    if tuple(obs.sensor_names) != tuple(spec.sensor_names):
+        raise ThermalDataError(
+            obs.source,
+            f"the observations hold sensors {list(obs.sensor_names)}, "
+            f"the model expects {list(spec.sensor_names)}",
+        )
+    if len(obs) == 0:
+        raise ThermalDataError(obs.source, "no observations")
+    obs.check_targets(geometry)
+
+
 def identify(
     obs: Observations,
     geometry: CellGeometry,
@@ -234,7 +246,7 @@ def identify(
     """
     options = options or IdentifyOptions()
     t0 = time.perf_counter()
-    obs.check_targets(geometry)
+    _check_inputs(obs, geometry, spec)
     problem = _Problem(obs, geometry, table, spec)
     report = identifiability(problem, spec, options)
     if not report.kept:
@@ -306,5 +318,5 @@ def plan_report(
     options: IdentifyOptions | None = None,
 ) -> IdentifiabilityReport:
     """The rank/condition report of a pose plan without fitting (e.g. on simulated observations)."""
-    obs.check_targets(geometry)
+    _check_inputs(obs, geometry, spec)
     return identifiability(_Problem(obs, geometry, table, spec), spec, options or IdentifyOptions())

@@ -82,17 +82,15 @@ class Observations:
         return len(self.time_s)
 
     def groups(self) -> Array:
-        """Group index (N,) int: rows with the same target id and the same joint vector."""
-        keys: list[tuple[str, Array]] = []
+        """Group index (N,) int: rows with the same target id and the same joint vector.
+
+        Joint vectors are compared after rounding to ``SAME_POSE_TOL_RAD``.
+        """
+        keys: dict[tuple[str, tuple[int, ...]], int] = {}
         out = np.empty(len(self), dtype=int)
-        for row, (tid, q) in enumerate(zip(self.target_ids, self.q_rad, strict=True)):
-            for g, (kt, kq) in enumerate(keys):
-                if kt == tid and np.max(np.abs(kq - q)) <= SAME_POSE_TOL_RAD:
-                    out[row] = g
-                    break
-            else:
-                keys.append((tid, q))
-                out[row] = len(keys) - 1
+        rounded = np.round(self.q_rad / SAME_POSE_TOL_RAD).astype(np.int64)
+        for row, (tid, q) in enumerate(zip(self.target_ids, rounded, strict=True)):
+            out[row] = keys.setdefault((tid, tuple(q.tolist())), len(keys))
         return out
 
     def check_targets(self, geometry: CellGeometry) -> None:
