@@ -11,8 +11,10 @@ from robots.dh import fk_dh
 from robots.thermal import (
     CellGeometry,
     DriftTruth,
+    IdentifyOptions,
     ThermalDataError,
     ThermalSpec,
+    ThermalSpecError,
     UnidentifiableError,
     default_settings,
     identify,
@@ -142,3 +144,8 @@ def test_sensor_names_must_match_the_spec(table, cell):
     spec = ThermalSpec.mapped(("amb",), (20.0,))
     with pytest.raises(ThermalDataError, match="the model expects"):
         identify(obs, cell[0], table, spec)
+
+
+def test_options_are_checked():
+    with pytest.raises(ThermalSpecError, match="max_condition"):
+        IdentifyOptions(max_condition=0.5)

@@ -15,6 +15,7 @@ import io
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -35,6 +36,9 @@ from robots.thermal import (
 from robots.thermal.csvio import read_observations, read_poses, write_observations
 from robots.thermal.modelfile import load_model, save_model
 from robots.thermal.plan import view_plan
+
+if TYPE_CHECKING:
+    from cell.config import CellConfig
 
 PREDICT_COLUMNS = (
     "tcp_x_cell_m",
@@ -94,7 +98,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     pred.add_argument(
         "--command",
         action="store_true",
-        help="also give the joint vector that puts the warm TCP on its nominal pose (q*_cmd_rad)",
+        help="also give the joint vector that puts the warm TCP on its nominal pose "
+        "(q*_cmd_rad, command_status); exit code 1 if any does not converge",
     )
     pred.set_defaults(handler=run_predict)
     sim = sub.add_parser(
@@ -126,11 +131,9 @@ def _table_of(model_name: str) -> DHTable:
     return Arm(model_name).dh
 
 
-def _geometry(cell_arg: str) -> tuple[CellGeometry, str, DHTable]:
-    from cell.config import load_cell
+def _geometry(cfg: CellConfig, cell_arg: str) -> tuple[CellGeometry, str, DHTable]:
     from cell.errors import ConfigError
 
-    cfg = load_cell(cell_arg)
     if not cfg.reference_targets:
         raise ConfigError(
             str(cfg.source_path or cell_arg),
@@ -174,7 +177,9 @@ def _write_atomic(path: Path, write) -> None:
 
 def run_identify(args: argparse.Namespace) -> int:
     """Identify the model from the observations and write thermal.json."""
-    geometry, model_name, table = _geometry(args.cell)
+    from cell.config import load_cell
+
+    geometry, model_name, table = _geometry(load_cell(args.cell), args.cell)
     obs = read_observations(args.observations, known_targets=set(geometry.targets_cell_m))
     link_sensors = None
     if args.sensor_map:
@@ -240,8 +245,8 @@ def run_simulate(args: argparse.Namespace) -> int:
                 )
             ],
         )
-    geometry, _, table = _geometry(args.cell)
     cfg = load_cell(args.cell)
+    geometry, _, table = _geometry(cfg, args.cell)
     arm = cfg.build_arm()
     targets = {t.id: (t.position, t.normal) for t in cfg.reference_targets}
     plan = view_plan(

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from robots.dh import DHTable
-from robots.thermal.errors import ThermalDataError, UnidentifiableError
+from robots.thermal.errors import ThermalDataError, ThermalSpecError, UnidentifiableError
 from robots.thermal.model import (
     TERM_SCALE,
     ThermalModel,
@@ -56,6 +56,14 @@ class IdentifyOptions:
     max_condition: float = 1e3
     effect_floor_m: float = 1e-9
     max_nfev: int = 200
+
+    def __post_init__(self) -> None:
+        if not self.max_condition > 1.0:
+            raise ThermalSpecError("max_condition", self.max_condition, "must be greater than 1")
+        if not self.effect_floor_m >= 0.0:
+            raise ThermalSpecError("effect_floor_m", self.effect_floor_m, "must be >= 0")
+        if self.max_nfev < 1:
+            raise ThermalSpecError("max_nfev", self.max_nfev, "must be at least 1")
 
 
 @dataclass(frozen=True)
