@@ -1,0 +1,171 @@
+"""GLNS-style large-neighbourhood search for the generalised TSP.
+
+Nodes ``0..N-1`` with node 0 the home depot; ``groups[h]`` lists hole h's nodes
+(candidate configurations); ``G[a, b]`` is the travel time (s) from node a to b.
+A tour visits one node per group, from home back to home.
+
+Each iteration removes some holes (random ones, or those nearest a random hole
+in travel time), reinserts each at its cheapest position with its cheapest
+node, improves the order by 2-opt/or-opt with nodes fixed, and re-chooses the
+node of every hole exactly for the new order (layered shortest path). A new
+tour replaces the current one when it is not worse by more than a threshold
+that shrinks to zero; the best tour is returned.
+
+Determinism: all randomness comes from ``numpy.random.default_rng(seed)``; the
+search stops after ``max_iterations`` or after ``patience`` iterations without
+a new best, whichever comes first. ``time_limit_s`` is a hard cap that only
+binds on a slow or loaded machine (then the result is reported as such).
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planner.local_search import improve_order
+
+
+@dataclass(frozen=True)
+class LnsSettings:
+    """Work limits of the search (see module docstring)."""
+
+    max_iterations: int
+    patience: int
+    time_limit_s: float
+    max_removed: int = 25
+    start_threshold: float = 0.003
+
+
+@dataclass(frozen=True)
+class LnsResult:
+    """Best tour: the hole order and the node visited for each, its cost (s), search facts."""
+
+    order: list[int]
+    nodes: list[int]
+    cost_s: float
+    iterations: int
+    hit_time_limit: bool
+
+
+def layered_nodes(
+    G: NDArray[np.floating], layers: Sequence[NDArray[np.int64]]
+) -> tuple[list[int], float]:
+    """Exact best node per layer for a fixed order of layers, home (node 0) at both ends."""
+    if not layers:
+        return [], 0.0
+    dist = G[0, layers[0]].astype(float)
+    back = []
+    for prev, cur in itertools.pairwise(layers):
+        total = dist[:, None] + G[prev[:, None], cur[None, :]]
+        arg = np.argmin(total, axis=0)
+        back.append(arg)
+        dist = total[arg, np.arange(len(cur))]
+    total = dist + G[layers[-1], 0]
+    pick = [int(np.argmin(total))]
+    cost = float(total[pick[0]])
+    for arg in reversed(back):
+        pick.append(int(arg[pick[-1]]))
+    pick.reverse()
+    return [int(layer[p]) for layer, p in zip(layers, pick, strict=True)], cost
+
+
+class GtspLns:
+    """The search over one problem instance (see module docstring)."""
+
+    def __init__(
+        self, G: NDArray[np.floating], groups: Sequence[NDArray[np.int64]], seed: int
+    ) -> None:
+        self.G = G
+        self.groups = [np.asarray(g, dtype=np.int64) for g in groups]
+        self.rng = np.random.default_rng(seed)
+
+    def _rechoose(self, order: list[int]) -> tuple[list[int], list[int], float]:
+        nodes, cost = layered_nodes(self.G, [self.groups[h] for h in order])
+        return order, nodes, cost
+
+    def _local(
+        self, order: list[int], nodes: list[int], cost: float
+    ) -> tuple[list[int], list[int], float]:
+        for _ in range(4):
+            path = [0, *nodes, 0]
+            perm = improve_order(self.G[np.ix_(path, path)].astype(float))
+            inner = [p - 1 for p in perm[1:-1]]
+            o2, n2, c2 = self._rechoose([order[p] for p in inner])
+            if not c2 < cost - 1e-9:
+                return (o2, n2, c2) if c2 <= cost else (order, nodes, cost)
+            order, nodes, cost = o2, n2, c2
+        return order, nodes, cost
+
+    def initial(self) -> tuple[list[int], list[int], float]:
+        """Greedy nearest-node construction from home, then local improvement."""
+        owner = np.full(self.G.shape[0], -1)
+        for h, g in enumerate(self.groups):
+            owner[g] = h
+        open_nodes = np.concatenate(self.groups)
+        cur, order = 0, []
+        while len(open_nodes):
+            nxt = int(open_nodes[np.argmin(self.G[cur, open_nodes])])
+            h = int(owner[nxt])
+            order.append(h)
+            open_nodes = open_nodes[owner[open_nodes] != h]
+            cur = nxt
+        return self._local(*self._rechoose(order))
+
+    def _remove(
+        self, order: list[int], nodes: list[int], k: int
+    ) -> tuple[list[int], list[int], list[int]]:
+        n = len(order)
+        if self.rng.random() < 0.5:
+            drop = set(self.rng.choice(n, size=k, replace=False).tolist())
+        else:
+            center = nodes[int(self.rng.integers(n))]
+            d = self.G[center, nodes] + self.G[nodes, center]
+            drop = set(np.argsort(d, kind="stable")[:k].tolist())
+        keep = [i for i in range(n) if i not in drop]
+        removed = [order[i] for i in sorted(drop)]
+        self.rng.shuffle(removed)
+        return [order[i] for i in keep], [nodes[i] for i in keep], removed
+
+    def _insert(self, order: list[int], nodes: list[int], removed: list[int]) -> list[int]:
+        for h in removed:
+            path = np.array([0, *nodes, 0])
+            cand = self.groups[h]
+            extra = (
+                self.G[np.ix_(path[:-1], cand)]
+                + self.G[np.ix_(cand, path[1:])].T
+                - self.G[path[:-1], path[1:]][:, None]
+            )
+            e, c = divmod(int(np.argmin(extra)), extra.shape[1])
+            order.insert(e, h)
+            nodes.insert(e, int(cand[c]))
+        return order
+
+    def run(self, settings: LnsSettings) -> LnsResult:
+        """Search from the greedy tour; returns the best tour found."""
+        started = time.perf_counter()
+        cur = best = self.initial()
+        n = len(self.groups)
+        since_best, hit, iterations = 0, False, 0
+        for it in range(settings.max_iterations):
+            if n < 3 or since_best >= settings.patience:
+                break
+            if time.perf_counter() - started > settings.time_limit_s:
+                hit = True
+                break
+            iterations = it + 1
+            k = int(self.rng.integers(1, max(2, min(settings.max_removed, n // 3)) + 1))
+            order, nodes, removed = self._remove(cur[0], cur[1], k)
+            new = self._local(*self._rechoose(self._insert(order, nodes, removed)))
+            threshold = settings.start_threshold * best[2] * (1 - it / settings.max_iterations)
+            if new[2] < cur[2] + threshold:
+                cur = new
+            if new[2] < best[2] - 1e-9:
+                best, since_best = new, 0
+            else:
+                since_best += 1
+        return LnsResult(best[0], best[1], best[2], iterations, hit)

@@ -1,0 +1,173 @@
+"""Collision-free joint paths between stops: the straight segment, else OMPL.
+
+:class:`MotionChecker` checks a motion at a set resolution: no joint moves more
+than ``joint_step_rad`` and the TCP no more than ``tcp_step_m`` between two
+checked configurations. :class:`SegmentPlanner` returns the straight joint
+segment when it is free, else plans with OMPL's RRT-Connect (validity by the
+arm's collision check, motions by :class:`MotionChecker`) and shortcuts and
+simplifies the result.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from planner.errors import SegmentPlanningError
+from planner.protocols import ArmLike
+
+log = logging.getLogger(__name__)
+
+_seeded: list[int] = []
+
+
+def seed_ompl(seed: int) -> None:
+    """Seed OMPL's random numbers (effective once per process, before any sampling)."""
+    if not _seeded:
+        ou.setLogLevel(ou.LogLevel.LOG_ERROR)
+        ou.RNG.setSeed(int(seed) + 1)  # OMPL treats 0 as "no seed"
+        _seeded.append(int(seed))
+
+
+def _interpolation_order(n: int) -> NDArray[np.int64]:
+    """Indices 1..n-1 coarse to fine (a van der Corput order), so collisions show early."""
+    order, seen = [], set()
+    step = 1 << max(int(np.ceil(np.log2(max(n, 2)))), 1)
+    while step >= 1:
+        for i in range(step, n, step):
+            if i not in seen:
+                seen.add(i)
+                order.append(i)
+        step //= 2
+    return np.array(order, dtype=np.int64)
+
+
+class MotionChecker:
+    """Collision checks of configurations and straight joint motions at a resolution."""
+
+    def __init__(self, arm: ArmLike, joint_step_rad: float, tcp_step_m: float) -> None:
+        self.arm = arm
+        self.joint_step = joint_step_rad
+        self.tcp_step = tcp_step_m
+        self.checks = 0
+
+    def state_free(self, q: NDArray[np.float64]) -> bool:
+        """True when ``q`` is within limits and free of collision."""
+        self.checks += 1
+        return self.arm.within_limits(q) and not self.arm.in_collision(q)
+
+    def samples(self, q_a: NDArray[np.float64], q_b: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Configurations on the straight segment, ends included, at the checker's resolution."""
+        n = max(int(np.ceil(np.abs(q_b - q_a).max() / self.joint_step)), 1)
+        for _ in range(8):
+            t = np.linspace(0.0, 1.0, n + 1)[:, None]
+            Q = q_a + t * (q_b - q_a)
+            tcp = self.arm.fk_dh(Q, "tcp")[:, :3, 3]
+            worst = np.linalg.norm(np.diff(tcp, axis=0), axis=1).max()
+            if worst <= self.tcp_step:
+                return Q
+            n = int(np.ceil(n * worst / self.tcp_step * 1.05))
+        return Q
+
+    def segment_free(
+        self, q_a: NDArray[np.float64], q_b: NDArray[np.float64], ends: bool = False
+    ) -> bool:
+        """True when the straight motion ``q_a`` to ``q_b`` is free (ends checked if ``ends``)."""
+        Q = self.samples(np.asarray(q_a, float), np.asarray(q_b, float))
+        if ends and not (self.state_free(Q[0]) and self.state_free(Q[-1])):
+            return False
+        return all(self.state_free(Q[i]) for i in _interpolation_order(len(Q) - 1))
+
+    def polyline_free(self, Q: NDArray[np.float64]) -> bool:
+        """True when the motion through the rows of ``Q`` (straight between rows) is free."""
+        if not self.state_free(Q[0]):
+            return False
+        return all(
+            self.segment_free(Q[i], Q[i + 1]) and self.state_free(Q[i + 1])
+            for i in range(len(Q) - 1)
+        )
+
+
+class _MotionValidator(ob.MotionValidator):
+    def __init__(self, si: ob.SpaceInformation, checker: MotionChecker, dof: int) -> None:
+        super().__init__(si)
+        self.checker = checker
+        self.dof = dof
+
+    def checkMotion(self, s1: ob.State, s2: ob.State) -> bool:
+        a = np.array([s1[i] for i in range(self.dof)])
+        b = np.array([s2[i] for i in range(self.dof)])
+        return bool(self.checker.segment_free(a, b) and self.checker.state_free(b))
+
+
+@dataclass(frozen=True)
+class SegmentPath:
+    """A collision-free joint path (m, dof) rad, straight between rows; ``planned`` if by OMPL."""
+
+    waypoints: NDArray[np.float64]
+    planned: bool
+
+
+class SegmentPlanner:
+    """Straight segment when free, else RRT-Connect + shortcutting (see module docstring)."""
+
+    def __init__(
+        self, checker: MotionChecker, lower: NDArray[np.float64], upper: NDArray[np.float64]
+    ) -> None:
+        self.checker = checker
+        self.dof = len(lower)
+        self.space = ob.RealVectorStateSpace(self.dof)
+        bounds = ob.RealVectorBounds(self.dof)
+        for i in range(self.dof):
+            bounds.setLow(i, float(lower[i]))
+            bounds.setHigh(i, float(upper[i]))
+        self.space.setBounds(bounds)
+        self.si = ob.SpaceInformation(self.space)
+        self.si.setStateValidityChecker(self._valid)
+        self.validator = _MotionValidator(self.si, checker, self.dof)
+        self.si.setMotionValidator(self.validator)
+        self.si.setup()
+
+    def _valid(self, state: ob.State) -> bool:
+        return bool(self.checker.state_free(np.array([state[i] for i in range(self.dof)])))
+
+    def _state(self, q: NDArray[np.float64]) -> ob.State:
+        s = self.si.allocState()
+        s[0 : self.dof] = [float(v) for v in q]
+        return s
+
+    def plan(
+        self,
+        q_a: NDArray[np.float64],
+        q_b: NDArray[np.float64],
+        time_s: float,
+        names: tuple[str, str],
+    ) -> SegmentPath:
+        """A free path ``q_a`` to ``q_b``, else :class:`SegmentPlanningError` naming ``names``."""
+        if self.checker.segment_free(q_a, q_b):
+            return SegmentPath(np.array([q_a, q_b]), planned=False)
+        pdef = ob.ProblemDefinition(self.si)
+        pdef.setStartAndGoalStates(self._state(q_a), self._state(q_b))
+        planner = og.RRTConnect(self.si)
+        planner.setProblemDefinition(pdef)
+        planner.setup()
+        status = planner.solve(ob.timedPlannerTerminationCondition(time_s))
+        if not pdef.hasExactSolution():
+            raise SegmentPlanningError(
+                *names, f"RRT-Connect found no path in {time_s:g} s ({status})"
+            )
+        path = pdef.getSolutionPath()
+        simplifier = og.PathSimplifier(self.si)
+        simplifier.simplify(path, min(time_s, 0.5))
+        Q = np.array(
+            [[path.getState(k)[i] for i in range(self.dof)] for k in range(path.getStateCount())]
+        )
+        Q[0], Q[-1] = q_a, q_b
+        log.info("segment %s -> %s: OMPL path with %d waypoints", names[0], names[1], len(Q))
+        return SegmentPath(Q, planned=True)

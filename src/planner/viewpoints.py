@@ -1,0 +1,150 @@
+"""Inspection viewpoints of a hole and their collision-free IK configurations.
+
+A viewpoint puts the TCP z axis along the view direction with the hole centre
+at ``standoff_m`` ahead of the TCP. The nominal view direction is the hole's
+inward normal (TCP z = -normal); an optional tilt cone adds directions at
+``tilt_deg`` from it. The roll about the view direction is sampled every
+``roll_step_deg``. For each pose, every IK solution within the joint limits
+(every branch, every J4/J6 value 2*pi apart) that is free of collision is a
+candidate. Collision is checked once per distinct arm geometry (values 2*pi
+apart put the arm in the same place).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import Counter
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planner.protocols import ArmLike, HoleLike
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class HoleCandidates:
+    """Collision-free configurations of one hole.
+
+    ``q`` (k, 6) rad; ``branch`` (k,) IK branch ids; ``pose`` (k,) index into ``poses``
+    (p, 4, 4) ``T_cell_tcp``. ``reason`` says why there is none (else ``None``).
+    """
+
+    hole_id: str
+    q: NDArray[np.float64]
+    branch: NDArray[np.int64]
+    pose: NDArray[np.int64]
+    poses: NDArray[np.float64]
+    reason: str | None
+
+    @property
+    def ok(self) -> bool:
+        """True when at least one candidate exists."""
+        return len(self.q) > 0
+
+
+def _basis(z: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    ref = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = ref - z * (ref @ z)
+    x /= np.linalg.norm(x)
+    return x, np.cross(z, x)
+
+
+def view_directions(
+    normal: NDArray[np.float64], tilt_deg: float, azimuths: int
+) -> NDArray[np.float64]:
+    """Unit view directions (cell frame): ``-normal`` and, if tilted, a ring on the cone."""
+    z = -np.asarray(normal, dtype=float)
+    z /= np.linalg.norm(z)
+    dirs = [z]
+    if tilt_deg > 0:
+        x, y = _basis(z)
+        tilt = np.radians(tilt_deg)
+        for k in range(azimuths):
+            phi = 2 * np.pi * k / azimuths
+            dirs.append(np.cos(tilt) * z + np.sin(tilt) * (np.cos(phi) * x + np.sin(phi) * y))
+    return np.array(dirs)
+
+
+def viewpoint_poses(
+    position_m: NDArray[np.float64],
+    normal: NDArray[np.float64],
+    standoff_m: float,
+    roll_step_deg: float,
+    tilt_deg: float = 0.0,
+    tilt_azimuths: int = 6,
+) -> NDArray[np.float64]:
+    """Every sampled ``T_cell_tcp`` (p, 4, 4) viewing the hole centre from ``standoff_m``."""
+    rolls = np.radians(np.arange(0.0, 360.0 - 1e-9, roll_step_deg))
+    poses = []
+    for z in view_directions(normal, tilt_deg, tilt_azimuths):
+        x0, y0 = _basis(z)
+        origin = np.asarray(position_m, dtype=float) - standoff_m * z
+        for roll in rolls:
+            c, s = np.cos(roll), np.sin(roll)
+            T = np.eye(4)
+            T[:3, :3] = np.column_stack((c * x0 + s * y0, -s * x0 + c * y0, z))
+            T[:3, 3] = origin
+            poses.append(T)
+    return np.array(poses)
+
+
+def _describe_collisions(arm: ArmLike, samples: list[NDArray[np.float64]]) -> str:
+    pairs: Counter[tuple[str, str]] = Counter()
+    for q in samples[:5]:
+        pairs.update(arm.colliding_pairs(q))
+    if not pairs:
+        return "in collision from every viewpoint"
+    (a, b), _ = pairs.most_common(1)[0]
+    return f"in collision from every viewpoint (e.g. {a} with {b})"
+
+
+def hole_candidates(
+    arm: ArmLike,
+    hole: HoleLike,
+    standoff_m: float,
+    roll_step_deg: float,
+    tilt_deg: float = 0.0,
+    tilt_azimuths: int = 6,
+) -> HoleCandidates:
+    """Collision-free IK configurations of every viewpoint of ``hole`` (see module docstring)."""
+    poses = viewpoint_poses(
+        hole.position_m, hole.normal, standoff_m, roll_step_deg, tilt_deg, tilt_azimuths
+    )
+    qs, branches, pose_ids = [], [], []
+    ik_reasons: Counter[str] = Counter()
+    colliding: list[NDArray[np.float64]] = []
+    n_solutions = 0
+    for p, T in enumerate(poses):
+        result = arm.ik(T)
+        if not result.ok:
+            ik_reasons[result.reason or "no IK solution"] += 1
+            continue
+        n_solutions += len(result.solutions)
+        wrapped = np.round((result.solutions + np.pi) % (2 * np.pi) - np.pi, 9)
+        _, first, inverse = np.unique(wrapped, axis=0, return_index=True, return_inverse=True)
+        free = np.array([not arm.in_collision(result.solutions[i]) for i in first])
+        keep = free[inverse.ravel()]
+        if not free.all():
+            colliding.extend(result.solutions[i] for i in first[~free])
+        qs.append(result.solutions[keep])
+        branches.append(np.asarray(result.branches)[keep])
+        pose_ids.append(np.full(int(keep.sum()), p))
+    q = np.vstack(qs) if qs else np.zeros((0, 6))
+    reason = None
+    if len(q) == 0:
+        if n_solutions:
+            reason = _describe_collisions(arm, colliding)
+        else:
+            reason = ", ".join(r for r, _ in ik_reasons.most_common()) or "no IK solution"
+    log.debug("hole %s: %d poses, %d candidates", hole.id, len(poses), len(q))
+    return HoleCandidates(
+        hole_id=hole.id,
+        q=q,
+        branch=np.concatenate(branches).astype(np.int64) if branches else np.zeros(0, np.int64),
+        pose=np.concatenate(pose_ids).astype(np.int64) if pose_ids else np.zeros(0, np.int64),
+        poses=poses,
+        reason=reason,
+    )
