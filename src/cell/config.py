@@ -94,9 +94,13 @@ class ShapeSpec(_Strict):
     name: str | None = None
 
     def model_post_init(self, __context: Any) -> None:
-        kinds = [k for k in ("box", "cylinder", "capsule", "sphere") if getattr(self, k) is not None]
+        kinds = [
+            k for k in ("box", "cylinder", "capsule", "sphere") if getattr(self, k) is not None
+        ]
         if len(kinds) != 1:
-            raise ValueError(f"a shape needs exactly one of box, cylinder, capsule, sphere (got {kinds})")
+            raise ValueError(
+                f"a shape needs exactly one of box, cylinder, capsule, sphere (got {kinds})"
+            )
 
     def to_shape(self, T_parent: np.ndarray, default_name: str) -> Shape:
         """The :class:`robots.Shape`, its pose premultiplied by ``T_parent``."""
@@ -281,7 +285,10 @@ def _pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
 
 def _duplicate_ids(cfg: CellConfig) -> list[tuple[str, object, str]]:
     problems = []
-    for group, items in (("part.holes", cfg.part.holes), ("reference_targets", cfg.reference_targets)):
+    for group, items in (
+        ("part.holes", cfg.part.holes),
+        ("reference_targets", cfg.reference_targets),
+    ):
         seen: set[str] = set()
         for i, item in enumerate(items):
             if item.id in seen:
@@ -298,7 +305,13 @@ def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
     q = cfg.home_q()
     if not arm.within_limits(q):
         bad = [arm.joint_names[i] for i in range(6) if not arm.lower[i] <= q[i] <= arm.upper[i]]
-        return [("robot.home", cfg.robot.home, f"outside the joint limits of {arm.name} ({', '.join(bad)})")]
+        return [
+            (
+                "robot.home",
+                cfg.robot.home,
+                f"outside the joint limits of {arm.name} ({', '.join(bad)})",
+            )
+        ]
     if arm.in_collision(q):
         pairs = ", ".join(f"{a} / {b}" for a, b in arm.colliding_pairs(q)[:3])
         return [("robot.home", cfg.robot.home, f"in collision ({pairs})")]
@@ -328,7 +341,9 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
 def builtin_cell_path(name: str = "motorcycle_frame") -> Path:
     """Path of a cell file shipped with the package."""
     if name not in BUILTIN_CELLS:
-        raise ConfigError(name, [("(name)", name, f"no built-in cell (known: {', '.join(BUILTIN_CELLS)})")])
+        raise ConfigError(
+            name, [("(name)", name, f"no built-in cell (known: {', '.join(BUILTIN_CELLS)})")]
+        )
     return DATA_DIR / f"{name}.yaml"
 
 

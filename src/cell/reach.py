@@ -33,13 +33,20 @@ class HoleReach:
         return self.n_free > 0
 
 
-def viewpoint(position_m: np.ndarray, normal: np.ndarray, standoff_m: float, roll_rad: float) -> np.ndarray:
+def viewpoint(
+    position_m: np.ndarray, normal: np.ndarray, standoff_m: float, roll_rad: float
+) -> np.ndarray:
     """``T_cell_tcp`` viewing a hole at ``position_m`` (cell frame) along ``-normal``."""
     return frame_from_z_axis(position_m + standoff_m * normal, -normal, roll_rad)
 
 
 def hole_reach(
-    arm: Arm, hole_id: str, position_m: np.ndarray, normal: np.ndarray, standoff_m: float, roll_step_rad: float
+    arm: Arm,
+    hole_id: str,
+    position_m: np.ndarray,
+    normal: np.ndarray,
+    standoff_m: float,
+    roll_step_rad: float,
 ) -> HoleReach:
     """Count usable IK branches of a hole's viewpoint over the sampled rolls."""
     rolls = np.arange(0.0, 2.0 * np.pi - 1e-9, roll_step_rad)

@@ -18,7 +18,14 @@ from robots.collision import CollisionModel
 from robots.dh import DHTable, dh_table, fk_dh
 from robots.errors import JointVectorError, UnknownModelError, UrdfError
 from robots.ik import IKResult, solve_ik
-from robots.models import ACCEL_PER_SPEED, DEFAULT_MODEL, JERK_PER_SPEED, JOINT_NAMES, MODELS, ArmSpec
+from robots.models import (
+    ACCEL_PER_SPEED,
+    DEFAULT_MODEL,
+    JERK_PER_SPEED,
+    JOINT_NAMES,
+    MODELS,
+    ArmSpec,
+)
 from robots.shapes import Shape
 from robots.transforms import invert
 from robots.urdf_writer import URDF_DIR
@@ -108,7 +115,7 @@ class Arm:
 
     # -- configuration of the cell -------------------------------------------------------
     def set_tool(self, T_tool0_tcp: ArrayLike, shapes: list[Shape] | None = None) -> None:
-        """Attach the tool: its TCP pose relative to ``tool0`` and its shapes (poses rel. to tool0)."""
+        """Attach the tool: its TCP pose and its shapes, both relative to ``tool0``."""
         self.T_tool0_tcp = np.asarray(T_tool0_tcp, dtype=float)
         self._T_tcp_tool0 = invert(self.T_tool0_tcp)
         self.tool_shapes = list(shapes or [])
@@ -124,7 +131,9 @@ class Arm:
         """The collision model (built on first use, rebuilt after tool or obstacle changes)."""
         if self._collision is None:
             in_base = [s.moved(self._T_base_cell) for s in self.obstacles]
-            self._collision = CollisionModel(self.model, self._robot_geoms, self.tool_shapes, in_base)
+            self._collision = CollisionModel(
+                self.model, self._robot_geoms, self.tool_shapes, in_base
+            )
         return self._collision
 
     # -- kinematics ------------------------------------------------------------------------
@@ -162,7 +171,7 @@ class Arm:
 
     # -- collision ---------------------------------------------------------------------------
     def in_collision(self, q: ArrayLike) -> bool:
-        """True when the arm touches itself (non-adjacent links), or arm or tool touch an obstacle."""
+        """True when the arm touches itself (non-adjacent links) or touches an obstacle."""
         return self.collision.in_collision(self.check_q(q))
 
     def colliding_pairs(self, q: ArrayLike) -> list[tuple[str, str]]:

@@ -106,9 +106,9 @@ class CollisionModel:
                 b = self.infos[j]
                 if a.body == "obstacle" and b.body == "obstacle":
                     continue
-                if a.body != "obstacle" and b.body != "obstacle":
-                    if abs(order[a.body] - order[b.body]) <= 1:
-                        continue
+                both_robot = a.body != "obstacle" and b.body != "obstacle"
+                if both_robot and abs(order[a.body] - order[b.body]) <= 1:
+                    continue
                 pairs.append((i, j))
         return pairs
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -67,30 +68,31 @@ def dh_table(spec: ArmSpec | str) -> DHTable:
     )
 
 
+@lru_cache(maxsize=64)
+def _constant_rows(table: DHTable) -> tuple[Array, Array, Array, Array]:
+    """``(a, cos alpha, sin alpha, rows 2-3 of every link transform)`` of a table."""
+    a, d, alpha, _ = table.arrays()
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    rows = np.zeros((6, 2, 4))
+    rows[:, 0, 1], rows[:, 0, 2], rows[:, 0, 3] = sa, ca, d
+    rows[:, 1, 3] = 1.0
+    return a, ca, sa, rows
+
+
 def link_transforms(table: DHTable, q: ArrayLike) -> Array:
     """Per-link transforms ``T_{i-1,i}``, shape ``(..., 6, 4, 4)``, for joints ``q`` (..., 6)."""
-    a, d, alpha, offset = table.arrays()
-    theta = np.asarray(q, dtype=float) + offset
+    a, ca, sa, rows = _constant_rows(table)
+    theta = np.asarray(q, dtype=float) + np.asarray(table.theta_offset_rad)
     ct, st = np.cos(theta), np.sin(theta)
-    ca, sa = np.cos(alpha), np.sin(alpha)
-    T = np.zeros((*theta.shape, 4, 4))
-    T[..., 0, 0] = ct
-    T[..., 0, 1] = -st * ca
-    T[..., 0, 2] = st * sa
-    T[..., 0, 3] = a * ct
-    T[..., 1, 0] = st
-    T[..., 1, 1] = ct * ca
-    T[..., 1, 2] = -ct * sa
-    T[..., 1, 3] = a * st
-    T[..., 2, 1] = sa
-    T[..., 2, 2] = ca
-    T[..., 2, 3] = d
-    T[..., 3, 3] = 1.0
+    T = np.empty((*theta.shape, 4, 4))
+    T[..., 0, :] = np.stack((ct, -st * ca, st * sa, a * ct), axis=-1)
+    T[..., 1, :] = np.stack((st, ct * ca, -ct * sa, a * st), axis=-1)
+    T[..., 2:, :] = rows
     return T
 
 
 def fk_dh(table: DHTable, q: ArrayLike) -> Array:
-    """``T_base_tool0`` from the D-H table; ``q`` of shape (6,) or (N, 6) gives (4, 4) or (N, 4, 4)."""
+    """``T_base_tool0`` from the D-H table; ``q`` (6,) or (N, 6) gives (4, 4) or (N, 4, 4)."""
     T_links = link_transforms(table, q)
     T = T_links[..., 0, :, :]
     for i in range(1, 6):

@@ -40,7 +40,7 @@ class IKResult:
     """Solutions of one IK query.
 
     Attributes:
-        solutions: (k, 6) joint vectors (rad), every branch and every value 2*pi apart within limits.
+        solutions: (k, 6) joint vectors (rad): every branch, every value 2*pi apart in limits.
         branches: (k,) branch number 0..7 of each solution.
         reason: ``None`` when there are solutions, else why not ("out of reach", "wrist singular",
             "shoulder singular", "outside limits").
@@ -112,11 +112,9 @@ def _wrist_solutions(R_0_3: Array, R_target: Array) -> list[tuple[float, float, 
     s5_abs = math.hypot(M[0, 2], M[1, 2])
     if s5_abs < WRIST_SINGULAR_TOL:
         return []
-    c5 = M[2, 2]
-    q5 = math.atan2(s5_abs, c5)
+    q5 = math.atan2(s5_abs, M[2, 2])
     q4 = math.atan2(-M[1, 2], -M[0, 2])
-    th6 = math.atan2(-M[2, 1], M[2, 0])
-    q6 = th6 - math.pi
+    q6 = math.atan2(-M[2, 1], M[2, 0]) - math.pi
     return [(q4, q5, q6, 0), (q4 + math.pi, -q5, q6 + math.pi, 1)]
 
 
@@ -180,7 +178,7 @@ def expand_within_limits(
 
 @lru_cache(maxsize=16)
 def _shift_grid(lower: tuple[float, ...], upper: tuple[float, ...]) -> Array:
-    """All combinations of per-joint shifts ``2*pi*k`` that can bring a value in [-pi, pi) within limits."""
+    """Every combination of per-joint shifts ``2*pi*k`` taking a value in [-pi, pi) into limits."""
     per_joint = []
     for lo, hi in zip(lower, upper, strict=True):
         ks = [k for k in range(-3, 4) if -math.pi + TWO_PI * k <= hi and math.pi + TWO_PI * k >= lo]

@@ -36,7 +36,9 @@ class Shape:
 
     def __post_init__(self) -> None:
         if self.kind not in KIND_SIZES:
-            raise ShapeError(self.name, f"unknown shape kind {self.kind!r} (one of {sorted(KIND_SIZES)})")
+            raise ShapeError(
+                self.name, f"unknown shape kind {self.kind!r} (one of {sorted(KIND_SIZES)})"
+            )
         expected = len(KIND_SIZES[self.kind])
         if len(self.size) != expected:
             raise ShapeError(

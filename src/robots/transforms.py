@@ -35,7 +35,9 @@ def make_transform(R: ArrayLike | None = None, t: ArrayLike | None = None) -> Ar
     return T
 
 
-def pose_to_matrix(xyz: ArrayLike, rpy: ArrayLike | None = None, quat_xyzw: ArrayLike | None = None) -> Array:
+def pose_to_matrix(
+    xyz: ArrayLike, rpy: ArrayLike | None = None, quat_xyzw: ArrayLike | None = None
+) -> Array:
     """4x4 transform from a position (m) and either rpy (rad) or a quaternion [x, y, z, w]."""
     if quat_xyzw is not None:
         R = Rotation.from_quat(np.asarray(quat_xyzw, dtype=float)).as_matrix()

@@ -4,8 +4,9 @@ The shipped files ``robots/urdf/<model>.urdf`` are this writer's output; a
 test keeps them equal. Collision geometry is coarse primitives that enclose
 each real link with a margin (URDF has no capsule: cylinders, spheres and
 boxes only). The lower arm (link_2) sits beside the plane of the forearm, as
-on ABB's arms whose J3 folds the forearm back past it. Shapes are laid out in the cell at q = 0, where every link frame
-is axis-aligned with ``base_link``, and shifted into their link frames.
+on ABB's arms whose J3 folds the forearm back past it. Shapes are laid out
+at q = 0, where every link frame is axis-aligned with ``base_link``, and
+shifted into their link frames.
 
 Run ``python -m robots.urdf_writer`` to rewrite the shipped files.
 """
@@ -67,7 +68,10 @@ def link_shapes(spec: ArmSpec) -> list[LinkShape]:
             (0.0, 0.0, 0.5 * (turret_top + 0.2 * s)),
         ),
         LinkShape(
-            "link_1", "box", (a1 + 0.34 * s, 0.62 * s, 0.26 * s), (0.5 * a1 - 0.05 * s, -0.08 * s, d1)
+            "link_1",
+            "box",
+            (a1 + 0.34 * s, 0.62 * s, 0.26 * s),
+            (0.5 * a1 - 0.05 * s, -0.08 * s, d1),
         ),
         # the lower arm runs beside the arm plane, so the forearm folds past it (J3 to -180 deg)
         LinkShape("link_2", "cylinder", (0.12 * s, a2 + 0.26 * s), (a1, -0.23 * s, d1 + 0.5 * a2)),
@@ -85,7 +89,9 @@ def link_shapes(spec: ArmSpec) -> list[LinkShape]:
             axis="x",
         ),
         LinkShape("link_5", "sphere", (0.1 * s,), (x_wrist, 0.0, z_fore)),
-        LinkShape("link_6", "cylinder", (0.05 * s, d6), (x_wrist + 0.5 * d6, 0.0, z_fore), axis="x"),
+        LinkShape(
+            "link_6", "cylinder", (0.05 * s, d6), (x_wrist + 0.5 * d6, 0.0, z_fore), axis="x"
+        ),
     ]
 
 
@@ -114,7 +120,9 @@ def _link_xml(link: str, shapes: list[LinkShape], origin: np.ndarray) -> list[st
                 f"      <geometry>{geometry}</geometry>",
             ]
             if tag == "visual":
-                lines.append('      <material name="abb_orange"><color rgba="0.93 0.45 0.0 1"/></material>')
+                lines.append(
+                    '      <material name="abb_orange"><color rgba="0.93 0.45 0.0 1"/></material>'
+                )
             lines.append(f"    </{tag}>")
     lines.append("  </link>")
     return lines

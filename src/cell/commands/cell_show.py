@@ -20,7 +20,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "show",
         help="summarise a cell and the reach of each hole",
         description=(
-            "Reads CELL (a cell.yaml; default: the built-in motorcycle frame) and prints the robot, "
+            "Reads CELL (a cell.yaml; default: the built-in motorcycle frame) and prints the "
+            "robot, "
             "tool, part, obstacles and, for each hole, how many IK solutions of its nominal "
             "viewpoint (roll about the view axis sampled) are within limits and collision-free. "
             "Writes nothing."
@@ -38,9 +39,7 @@ def _summary(cfg: CellConfig) -> list[str]:
     lines = [
         f"cell      {cfg.name}  ({cfg.source_path})",
         f"robot     {arm.name}  base xyz {base.xyz}  home {np.round(cfg.home_q(), 4).tolist()} rad",
-        "          limits  vel "
-        + " ".join(f"{v:.2f}" for v in arm.velocity_limit)
-        + " rad/s",
+        "          limits  vel " + " ".join(f"{v:.2f}" for v in arm.velocity_limit) + " rad/s",
         f"tool      tcp {cfg.tool.tool0_to_tcp.xyz} from tool0, standoff {cfg.tool.standoff_m} m, "
         f"{len(cfg.tool.shapes)} shapes",
         f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes, "
@@ -49,7 +48,9 @@ def _summary(cfg: CellConfig) -> list[str]:
         f"{len(cfg.reference_targets)} reference targets",
     ]
     if arm.collision.excluded_pairs:
-        lines.append(f"note      pairs touching at q=0, not checked: {arm.collision.excluded_pairs}")
+        lines.append(
+            f"note      pairs touching at q=0, not checked: {arm.collision.excluded_pairs}"
+        )
     return lines
 
 
@@ -65,7 +66,8 @@ def run_show(args: argparse.Namespace) -> int:
     unreachable = 0
     rows = [(h.id, h.diameter_m, h.position_m, h.normal) for h in cfg.holes_in_cell()]
     rows += [
-        (f"{t.id}*", t.diameter, np.array(t.position), np.array(t.normal)) for t in cfg.reference_targets
+        (f"{t.id}*", t.diameter, np.array(t.position), np.array(t.normal))
+        for t in cfg.reference_targets
     ]
     for hid, diameter, position, normal in rows:
         r = hole_reach(arm, hid, position, normal, cfg.tool.standoff_m, step)
