@@ -15,8 +15,11 @@ Two costs:
   so for millimetre holes the plane term dominates and the radius and centre are weighted
   arbitrarily; it is kept for the benchmark comparison.
 
-Robustness: two iteratively reweighted passes with Cauchy weights, then iterative
-rejection of points farther than
+Robustness: if less than 90 % of the points lie within 0.5 % of the radius (at least 10 µm)
+of the refined
+published start, a three-point RANSAC circle with more support replaces it; then two
+iteratively reweighted passes with Cauchy weights, then iterative rejection of points
+farther than
 ``reject_sigma`` robust standard deviations (MAD) from the circle, refitted with plain LM on
 the inliers. The number rejected is reported.
 """
@@ -131,6 +134,48 @@ def _solve(pts, w, c, n, r, cost):
     return cc / k, nn, rr / k, sol, k
 
 
+def circle_through(p1: np.ndarray, p2: np.ndarray, p3: np.ndarray):
+    """Circles through point triples (K, 3) each: centres (K, 3), unit normals, radii."""
+    a, b = p1 - p3, p2 - p3
+    axb = np.cross(a, b)
+    den = 2.0 * np.einsum("ij,ij->i", axb, axb)
+    aa, bb = np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", b, b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = p3 + np.cross(aa[:, None] * b - bb[:, None] * a, axb) / den[:, None]
+        n = axb / np.sqrt(0.5 * den)[:, None]
+    return c, n, np.linalg.norm(p1 - c, axis=1)
+
+
+def ransac_circle(
+    pts: np.ndarray,
+    w: np.ndarray,
+    r_guess: float,
+    trials: int = 96,
+    tol_frac: float = 0.005,
+    tol_min_m: float = 10e-6,
+    seed: int = 0,
+) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Best-supported circle through three points (support: points within
+    max(``tol_frac`` × radius, ``tol_min_m``)).
+
+    Returns centre, normal, radius and the supporting weight fraction. Seeded.
+    """
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, len(pts), size=(trials, 3))
+    c, n, r = circle_through(pts[idx[:, 0]], pts[idx[:, 1]], pts[idx[:, 2]])
+    ok = np.isfinite(r) & (r > 0.25 * r_guess) & (r < 4.0 * r_guess)
+    if not ok.any():
+        return c[0], n[0], float(r_guess), 0.0
+    c, n, r = c[ok], n[ok], r[ok]
+    d = pts[None, :, :] - c[:, None, :]
+    h = np.einsum("kij,kj->ki", d, n)
+    rho = np.sqrt(np.maximum(np.einsum("kij,kij->ki", d, d) - h * h, 0.0))
+    dist = np.hypot(h, rho - r[:, None])
+    support = ((dist < np.maximum(tol_frac * r, tol_min_m)[:, None]) * w[None, :]).sum(axis=1)
+    k = int(np.argmax(support))
+    return c[k], n[k], float(r[k]), float(support[k] / w.sum())
+
+
 def _sigma(d: np.ndarray, floor: float) -> float:
     """Robust σ of isotropic 2-D residuals from their distances (Rayleigh median)."""
     return max(float(np.median(d)) / 1.1774, floor)
@@ -175,12 +220,27 @@ def fit_circle_3d(
     pts, w = pts_all[usable], w_all[usable]
     c, n, r = initial_circle(pts, w)
     floor = min_reject_m / reject_sigma
-    if robust:  # two Cauchy-weighted (IRLS) passes pull the start away from outliers
+    if robust:
+        # the published start, refined; if a 3-point RANSAC circle has more support within
+        # 0.5 % of the radius (a dented or partly false contour), start from that instead
+        c, n, r, *_ = _solve(pts, w, c, n, r, cost)
+        tol = max(0.005 * r, 10e-6)
+        own = float((w * (orthogonal_distance(pts, c, n, r) < tol)).sum() / w.sum())
+        if own < 0.9:
+            rc, rn, rr, support = ransac_circle(pts, w, r)
+            if support > own:
+                c, n, r = rc, rn, rr
+        # two Cauchy-weighted (IRLS) passes pull the start away from remaining outliers
         for _ in range(2):
             d = orthogonal_distance(pts, c, n, r)
             s = _sigma(d, floor)
             c, n, r, *_ = _solve(pts, w / (1.0 + (d / (2.385 * s)) ** 2), c, n, r, cost)
     inl = np.ones(len(pts), dtype=bool)
+    if robust:
+        d = orthogonal_distance(pts, c, n, r)
+        inl = d < reject_sigma * _sigma(d, floor)
+        if inl.sum() < 6:
+            inl = np.ones(len(pts), dtype=bool)
     for _ in range(6 if robust else 1):
         c, n, r, sol, k = _solve(pts[inl], w[inl], c, n, r, cost)
         if not robust:

@@ -50,19 +50,46 @@ def ellipse_distance(pts: np.ndarray, ell: Ellipse) -> np.ndarray:
     return (rel - 1.0) * rad
 
 
-def robust_ellipse(pts: np.ndarray, iterations: int = 4) -> tuple[Ellipse, np.ndarray]:
-    """``cv2.fitEllipse`` with iterative rejection (MAD, floor 0.5 px); returns the inlier mask."""
-    inl = np.ones(len(pts), dtype=bool)
+def robust_ellipse(
+    pts: np.ndarray, trials: int = 48, tol_px: float = 1.0, floor_px: float = 2.0, seed: int = 0
+) -> tuple[Ellipse, np.ndarray]:
+    """``cv2.fitEllipse`` made robust by RANSAC over the ordered contour.
+
+    Each trial fits an ellipse to six points, one from each sixth of the contour, and counts
+    the points within ``tol_px``; the best consensus is refitted, then points within
+    max(4σ, ``floor_px``) of it are the inliers. A contiguous false arc far from the rest (a
+    reflection, a false edge) cannot win. A shallow dent (a burr over the rim) can look
+    like an ellipse in one image; the 3-D circle fit, which needs a *circle*, sorts that
+    out, so the floor is generous. Seeded, so results are repeatable.
+    """
+    n = len(pts)
     ell = cv2.fitEllipse(pts.astype(np.float32))
-    for _ in range(iterations):
-        d = ellipse_distance(pts, ell)
-        mad = 1.4826 * float(np.median(np.abs(d[inl] - np.median(d[inl]))))
-        new = np.abs(d) < max(4.0 * mad, 0.5)
-        if new.sum() < 6 or np.array_equal(new, inl):
-            inl = new if new.sum() >= 6 else inl
-            break
-        inl = new
+    if n >= 24:
+        rng = np.random.default_rng(seed)
+        bounds = np.linspace(0, n, 7).astype(int)
+        best, best_score = ell, np.count_nonzero(np.abs(ellipse_distance(pts, ell)) < tol_px)
+        for _ in range(trials):
+            idx = [rng.integers(bounds[k], bounds[k + 1]) for k in range(6)]
+            try:
+                cand = cv2.fitEllipse(pts[idx].astype(np.float32))
+            except cv2.error:
+                continue
+            if not np.all(np.isfinite(cand[1])) or min(cand[1]) <= 0:
+                continue
+            score = np.count_nonzero(np.abs(ellipse_distance(pts, cand)) < tol_px)
+            if score > best_score:
+                best, best_score = cand, score
+        ell = best
+        inl = np.abs(ellipse_distance(pts, ell)) < tol_px
+        if inl.sum() >= 6:
+            ell = cv2.fitEllipse(pts[inl].astype(np.float32))
+    d = ellipse_distance(pts, ell)
+    sigma = 1.4826 * float(np.median(np.abs(d)))
+    inl = np.abs(d) < max(4.0 * sigma, floor_px)
+    if inl.sum() >= 6:
         ell = cv2.fitEllipse(pts[inl].astype(np.float32))
+        d = ellipse_distance(pts, ell)
+        inl = np.abs(d) < max(4.0 * sigma, floor_px)
     ell = (
         (float(ell[0][0]), float(ell[0][1])),
         (float(ell[1][0]), float(ell[1][1])),
@@ -100,12 +127,36 @@ def _polar_clean(r: np.ndarray, window: int = 9) -> np.ndarray:
     return np.abs(r - med) < 1.0
 
 
+def curvature_correction(pts: np.ndarray, ell: Ellipse, sigma_px: float) -> np.ndarray:
+    """Undo the inward shift of gradient maxima on a curved blurred edge.
+
+    A Gaussian-blurred edge of curvature κ has its gradient maximum displaced toward the
+    centre of curvature by σ²κ/2 (to first order). Each point moves back along the
+    ellipse's outward normal by that amount; κ comes from the image ellipse.
+    """
+    (cx, cy), (a2, b2), ang = ell
+    t = np.deg2rad(ang)
+    c, s = np.cos(t), np.sin(t)
+    a, b = a2 / 2.0, b2 / 2.0
+    d = pts - (cx, cy)
+    u = d[:, 0] * c + d[:, 1] * s
+    v = -d[:, 0] * s + d[:, 1] * c
+    phi = np.arctan2(v / b, u / a)
+    kappa = a * b / (a * a * np.sin(phi) ** 2 + b * b * np.cos(phi) ** 2) ** 1.5
+    nu, nv = np.cos(phi) / a, np.sin(phi) / b  # outward normal ∝ (u/a², v/b²)
+    norm = np.hypot(nu, nv)
+    nu, nv = nu / norm, nv / norm
+    shift = 0.5 * sigma_px**2 * kappa
+    return pts + shift[:, None] * np.stack([nu * c - nv * s, nu * s + nv * c], axis=1)
+
+
 def build_contour(
     edge_px: np.ndarray,
     centroid_px: tuple[float, float],
     arc_step_px: float = 1.0,
     short_gap_px: float = 4.0,
     max_points: int = 2048,
+    blur_sigma_px: float = 0.0,
 ) -> Contour | None:
     """Resample edge points along lines through the centroid; fill gaps; fit the ellipse."""
     if len(edge_px) < 12:
@@ -120,6 +171,10 @@ def build_contour(
     if len(theta) < 12:
         return None
     ell, inl = robust_ellipse(pts)
+    if blur_sigma_px > 0:
+        pts = curvature_correction(pts, ell, blur_sigma_px)
+        d = pts - c
+        theta, r = np.arctan2(d[:, 1], d[:, 0]), np.hypot(d[:, 0], d[:, 1])
     n_out = int((~inl).sum())
     theta, r = theta[inl], r[inl]
     r_mean = float(np.mean(r))

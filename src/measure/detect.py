@@ -1,7 +1,8 @@
 """Finding the hole in one image: exposure checks and disc-like region candidates.
 
 The search runs on every 4th pixel of each row and column (well under a ms for 5 MP): a
-threshold midway between the darkest pixels and the median, connected components of the
+threshold a third of the way from the darkest pixels to the median (so a chamfer ring
+stays outside the hole), connected components of the
 dark (or, failing that, bright) class, and a disc test: an ellipse fitted to the region's
 outline must follow most of it closely. Regions cut by the border are kept and flagged, so
 the caller can say so instead of "no hole".
@@ -111,10 +112,10 @@ def _masks(small: np.ndarray):
     """(polarity, threshold 0..255, mask) for the dark class, then the bright class."""
     p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
     if p_med - p_lo >= 0.12 * 255:
-        thr = 0.5 * (p_lo + p_med)
+        thr = p_lo + (p_med - p_lo) / 3.0
         yield "dark", thr, small <= thr
     if p_hi - p_med >= 0.12 * 255:
-        thr = 0.5 * (p_hi + p_med)
+        thr = p_hi - (p_hi - p_med) / 3.0
         yield "bright", thr, small > thr
 
 

@@ -19,6 +19,8 @@ class MeasureOptions:
             (published linear interpolation of gray values).
         circle_cost: ``"orthogonal"`` (true orthogonal distance, default) or ``"published"``.
         smoothing_sigma_px: Gaussian smoothing before the gradient (pixels).
+        curvature_correction: move edge points outward by σ²κ/2, the shift of gradient
+            maxima on a blurred curved edge (σ measured from the edge profile).
         arc_step_px: spacing of the lines through the centroid, in pixels of arc.
         short_gap_px: gaps up to this length (px) are filled along the contour and used in
             the fit; longer gaps are filled from the image ellipse, reported, not used.
@@ -33,7 +35,8 @@ class MeasureOptions:
 
     edge_method: str = "parabola"
     circle_cost: str = "orthogonal"
-    smoothing_sigma_px: float = 1.0
+    smoothing_sigma_px: float = 0.5
+    curvature_correction: bool = True
     arc_step_px: float = 1.0
     short_gap_px: float = 4.0
     use_long_fills: bool = False
@@ -45,7 +48,12 @@ class MeasureOptions:
     @classmethod
     def published(cls) -> MeasureOptions:
         """The published method: linear interpolation, published cost, all filled points used."""
-        return cls(edge_method="linear", circle_cost="published", use_long_fills=True)
+        return cls(
+            edge_method="linear",
+            circle_cost="published",
+            use_long_fills=True,
+            curvature_correction=False,
+        )
 
 
 @dataclass(frozen=True)

@@ -140,7 +140,7 @@ def shade(geo: HoleGeometry, sh: Shading, nx: np.ndarray, ny: np.ndarray) -> np.
         hit = np.isfinite(best)
         hx, hy = ox + best[hit] * dx[hit], oy + best[hit] * dy[hit]
         az = np.arctan2(hy, hx)
-        val[hit] = sh.chamfer * (1.0 + 0.25 * np.cos(az - 0.8)) * _surface_texture(
+        val[hit] = sh.chamfer * (1.0 + 0.15 * np.cos(az - 0.8)) * _surface_texture(
             hx, hy, sh
         ) + 0.6 * _highlight(hx, hy, r, sh)
         done |= hit
