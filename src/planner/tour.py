@@ -165,7 +165,12 @@ def tour_from_dict(data: dict[str, Any], where: str = "<tour>") -> Tour:
     dt = float(_require(data, "dt", (int, float), where))
     if not (dt > 0 and math.isfinite(dt)):
         raise TourFileError(where, "dt", f"must be a positive number of seconds, got {dt!r}")
-    left = _require(data, "left_out", list, where)
+    left = []
+    for i, h in enumerate(_require(data, "left_out", list, where)):
+        if not isinstance(h, dict):
+            raise TourFileError(where, f"left_out[{i}]", "expected a mapping")
+        hole_id = _require(h, "hole_id", str, where)
+        left.append(LeftOut(str(hole_id), str(_require(h, "reason", str, where))))
     return Tour(
         cell_name=str(_require(cell, "name", str, where)),
         cell_sha256=str(_require(cell, "sha256", str, where)),
@@ -173,7 +178,7 @@ def tour_from_dict(data: dict[str, Any], where: str = "<tour>") -> Tour:
         joint_names=names,
         home_q=_vector(data.get("home_q"), n, where, "home_q"),
         stops=stops,
-        left_out=[LeftOut(str(h["hole_id"]), str(h["reason"])) for h in left],
+        left_out=left,
         dt=dt,
         trajectory=traj,
         cycle_time_s=float(_require(data, "cycle_time_s", (int, float), where)),
