@@ -1,0 +1,33 @@
+"""Errors of the controller link, all derived from :class:`cell.errors.CellError`."""
+
+from __future__ import annotations
+
+from cell.errors import CellError
+
+
+class LinkError(CellError):
+    """The link to the controller failed (port cannot be opened, no answer after retries)."""
+
+    def __init__(self, url: str, reason: str) -> None:
+        self.url = url
+        self.reason = reason
+        super().__init__(f"controller link {url}: {reason}")
+
+
+class PayloadError(CellError):
+    """A message payload does not have the layout its type requires."""
+
+    def __init__(self, msg_type: int, reason: str) -> None:
+        self.msg_type = msg_type
+        self.reason = reason
+        super().__init__(f"message type 0x{msg_type:02X}: {reason}")
+
+
+class RequestRefusedError(CellError):
+    """The controller answered a request with a NAK (``code``: :class:`cell.link.messages.Nak`)."""
+
+    def __init__(self, request: str, code: int, text: str) -> None:
+        self.request = request
+        self.code = code
+        self.text = text
+        super().__init__(f"controller refused {request}: {text} (NAK code {code})")

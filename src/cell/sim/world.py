@@ -1,0 +1,109 @@
+"""The simulated cell's hidden truth: its clock, the drifted kinematics and the true holes.
+
+The runner never reads this module's state; it sees only what the controller reports over the
+link (joints, temperatures) and what the cameras capture. The simulation clock runs ``speed``
+times faster than the wall clock; the thermal drift is evaluated at ``drift_offset_s`` plus the
+simulation time, so a run can start on a half-warm arm.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from robots.thermal.drift import DriftSettings, DriftTruth, default_settings
+
+
+class SimClock:
+    """Simulation time: ``speed`` simulation seconds per wall second, from construction."""
+
+    def __init__(self, speed: float = 1.0) -> None:
+        if not speed > 0:
+            raise ValueError(f"speed {speed} must be > 0")
+        self.speed = float(speed)
+        self._wall0 = time.monotonic()
+
+    def now(self) -> float:
+        """Simulation time (s) since the start."""
+        return (time.monotonic() - self._wall0) * self.speed
+
+    def wall_for(self, sim_s: float) -> float:
+        """Wall seconds that ``sim_s`` simulation seconds take."""
+        return sim_s / self.speed
+
+
+@dataclass(frozen=True)
+class TrueHole:
+    """A hole as it really is (cell frame, m): centre, unit normal out of the surface, diameter."""
+
+    id: str
+    position_m: np.ndarray
+    normal: np.ndarray
+    diameter_m: float
+
+
+@dataclass(frozen=True)
+class WorldOptions:
+    """Settings of the truth.
+
+    Attributes:
+        speed: simulation seconds per wall second (> 0).
+        drift_offset_s: warm-up time already elapsed when the simulation starts (s).
+        drift: the drift generator's settings (None: ``robots.thermal.drift.default_settings``).
+        position_sigma_m: standard deviation of each true hole centre from nominal, in the
+            surface plane (m): the part as machined.
+        diameter_sigma_m: standard deviation of each true diameter from nominal (m).
+        seed: seed of the part errors and the sensor noise.
+    """
+
+    speed: float = 1.0
+    drift_offset_s: float = 1800.0
+    drift: DriftSettings | None = None
+    position_sigma_m: float = 50e-6
+    diameter_sigma_m: float = 10e-6
+    seed: int = 0
+
+
+class SimWorld:
+    """The truth of one simulated cell: built from a :class:`cell.config.CellConfig`."""
+
+    def __init__(self, cell, options: WorldOptions | None = None) -> None:
+        self.options = options or WorldOptions()
+        self.clock = SimClock(self.options.speed)
+        self.cell = cell
+        self.arm = cell.build_arm()
+        self.T_cell_base = np.asarray(cell.T_cell_base(), dtype=float)
+        self.T_tool0_tcp = np.asarray(cell.T_tool0_tcp(), dtype=float)
+        settings = self.options.drift or default_settings()
+        self.drift = DriftTruth(self.arm.dh, settings, seed=self.options.seed)
+        self.holes = self._true_holes(np.random.default_rng(self.options.seed))
+
+    def _true_holes(self, rng: np.random.Generator) -> dict[str, TrueHole]:
+        out: dict[str, TrueHole] = {}
+        for h in self.cell.holes_in_cell():
+            n = np.asarray(h.normal, dtype=float)
+            u = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+            u /= np.linalg.norm(u)
+            v = np.cross(n, u)
+            du, dv = rng.normal(0.0, self.options.position_sigma_m, 2)
+            dd = rng.normal(0.0, self.options.diameter_sigma_m)
+            out[h.id] = TrueHole(
+                h.id, np.asarray(h.position_m, float) + du * u + dv * v, n, h.diameter_m + dd
+            )
+        return out
+
+    def temperatures(self, t_s: float) -> np.ndarray:
+        """What the controller's sensors read (degC) at simulation time ``t_s``."""
+        return np.asarray(self.drift.sensor_readings(self.options.drift_offset_s + t_s), float)
+
+    def sensor_names(self) -> tuple[str, ...]:
+        """Names of the temperature sensors, in the order STATUS reports them."""
+        return self.drift.settings.sensor_names
+
+    def true_T_cell_tcp(self, q_rad: np.ndarray, t_s: float) -> np.ndarray:
+        """The true (drifted) TCP pose in the cell at joints ``q_rad`` and time ``t_s``."""
+        t_drift = self.options.drift_offset_s + t_s
+        T_base_tool0 = self.drift.T_base_tool0(np.asarray(q_rad, float), t_drift)
+        return self.T_cell_base @ T_base_tool0 @ self.T_tool0_tcp

@@ -1,0 +1,122 @@
+"""The link client against the simulated controller over a pty and a socket, with faults."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from cell.link import messages as m
+from cell.link.client import ControllerClient, LinkOptions
+from cell.link.errors import LinkError, RequestRefusedError
+from cell.sim.controller import SimController
+from cell.sim.faults import FaultPlan
+from cell.sim.server import SimServer
+from cell.sim.world import SimClock
+
+HOME = np.array([0.0, -0.3, 0.4, 0.0, 0.5, 0.0])
+FAST = LinkOptions(response_timeout_s=0.03, retries=40, heartbeat_period_s=0.05)
+
+
+def _trajectory(n: int = 200) -> tuple[np.ndarray, list[int]]:
+    s = np.linspace(0.0, 1.0, n)[:, None]
+    out = HOME + np.sin(np.pi * s) * np.array([0.5, 0.2, -0.1, 1.0, 0.3, -2.0])
+    return out, [50, 100, 150]
+
+
+def _server(faults: FaultPlan | None = None, transport: str = "pty", **kw) -> SimServer:
+    temps = lambda t: np.array([20.0 + 0.01 * t, 21.0])  # noqa: E731
+    ctrl = SimController(SimClock(kw.pop("speed", 50.0)), temps, "abb_test", HOME, **kw)
+    return SimServer(ctrl, faults, transport).start()
+
+
+@pytest.mark.parametrize("transport", ["pty", "socket"])
+def test_identify_load_move_and_status(transport: str) -> None:
+    q, stops = _trajectory()
+    with _server(transport=transport) as sim, ControllerClient(sim.url, FAST) as c:
+        assert c.identity.robot_model == "abb_test" and c.identity.version == m.PROTOCOL_VERSION
+        traj_id = c.load_trajectory(q, stops, 0.004)
+        assert c.load_trajectory(q, stops, 0.004) == traj_id  # already loaded: no transfer
+        for k in range(len(stops)):
+            c.move_to_stop(k)
+            st = c.wait_in_position(k, timeout_s=5.0)
+            assert st.state == m.State.IN_POSITION and st.at_stop == k
+            np.testing.assert_allclose(st.q_rad, q[stops[k]], atol=1e-7)
+        c.move_to_stop(len(stops))
+        st = c.wait_in_position(len(stops), timeout_s=5.0)
+        np.testing.assert_allclose(st.q_rad, q[-1], atol=1e-7)
+        assert st.temperatures_c.shape == (2,) and st.traj_id == traj_id
+
+
+def test_moves_backwards_along_the_path_and_stop_holds() -> None:
+    q, stops = _trajectory()
+    with _server(speed=5.0) as sim, ControllerClient(sim.url, FAST) as c:
+        c.load_trajectory(q, stops, 0.004)
+        c.move_to_stop(2)
+        time.sleep(0.08)
+        c.stop()
+        st = c.status()
+        assert st.state == m.State.STOPPED and 0 < st.row < stops[2]
+        c.move_to_stop(0)
+        st = c.wait_in_position(0, timeout_s=5.0)
+        np.testing.assert_allclose(st.q_rad, q[stops[0]], atol=1e-7)
+
+
+def test_faulty_line_still_delivers_every_request_once() -> None:
+    q, stops = _trajectory(600)
+    faults = FaultPlan(drop=0.05, corrupt=0.05, delay=0.05, delay_s=0.04, seed=3)
+    with _server(faults) as sim, ControllerClient(sim.url, FAST) as c:
+        c.load_trajectory(q, stops, 0.004)
+        for k in range(len(stops)):
+            c.move_to_stop(k)
+            assert c.wait_in_position(k, timeout_s=10.0).at_stop == k
+        assert sim.dropped > 0 and sim.corrupted > 0
+        assert c.stats.retransmits > 0
+
+
+def test_estop_latches_until_reset() -> None:
+    q, stops = _trajectory()
+    with _server(estop_at_stop=1) as sim, ControllerClient(sim.url, FAST) as c:
+        c.load_trajectory(q, stops, 0.004)
+        c.move_to_stop(1)
+        st = c.wait_in_position(1, timeout_s=5.0)
+        assert st.state == m.State.ESTOP and st.fault == m.Fault.ESTOP
+        with pytest.raises(RequestRefusedError, match="RESET"):
+            c.move_to_stop(2)
+        c.reset()
+        c.move_to_stop(1)
+        assert c.wait_in_position(1, timeout_s=5.0).state == m.State.IN_POSITION
+
+
+def test_link_loss_stops_the_arm_on_the_path() -> None:
+    q, stops = _trajectory(2000)
+    with _server(speed=1.0, link_timeout_s=0.1) as sim:
+        c = ControllerClient(sim.url, LinkOptions(response_timeout_s=0.03, heartbeat_period_s=60))
+        c.connect()
+        c.load_trajectory(q, [1900], 0.004)
+        c.move_to_stop(0)
+        c._stop_hb.set()
+        time.sleep(0.3)
+        st = c.status()
+        assert st.state == m.State.STOPPED and st.fault == m.Fault.LINK_LOST
+        assert 0 < st.row < 1900
+        c.close()
+
+
+def test_socket_disconnect_then_reconnect() -> None:
+    faults = FaultPlan(disconnect_after=5, disconnect_s=0.2)
+    with _server(faults, transport="socket") as sim:
+        c = ControllerClient(sim.url, LinkOptions(response_timeout_s=0.03, retries=3))
+        c.connect()
+        with pytest.raises(LinkError):
+            for _ in range(10):
+                c.status()
+        c.reconnect(budget_s=5.0)
+        assert c.status().state == m.State.IDLE
+        c.close()
+
+
+def test_bad_port_gives_clear_error() -> None:
+    with pytest.raises(LinkError, match="/dev/does-not-exist"):
+        ControllerClient("/dev/does-not-exist", LinkOptions(open_timeout_s=0.1)).connect()
