@@ -75,7 +75,9 @@ def _pick_pair(
     for i, a in enumerate(left):
         for j, b in enumerate(right):
             if abs(cl[i, 1] - cr[j, 1]) > max(6.0, 0.1 * a.diameter_px):
-                continue
+                continue  # not on the same epipolar line
+            if abs(a.diameter_px - b.diameter_px) > 0.25 * max(a.diameter_px, b.diameter_px):
+                continue  # two views of one hole have about the same size
             X = triangulate(stereo, cl[i : i + 1], cr[j : j + 1], optimal=False)[0]
             d_m = 0.5 * (a.diameter_px + b.diameter_px) * X[2] / f
             scored.append((abs(d_m / expected_m - 1.0), i, j))

@@ -6,7 +6,13 @@ from functools import lru_cache
 
 import numpy as np
 
-from measure.synth import RenderOptions, StereoRender, hole_in_view, render_hole_pair, toed_in_stereo
+from measure.synth import (
+    RenderOptions,
+    StereoRender,
+    hole_in_view,
+    render_hole_pair,
+    toed_in_stereo,
+)
 
 
 @lru_cache(maxsize=1)

@@ -18,7 +18,12 @@ def test_round_trip(tmp_path):
     st.save(path)
     back = StereoCalibration.load(path)
     assert back.image_size == (2448, 2048)
-    for a, b in ((st.K_left, back.K_left), (st.R, back.R), (st.T, back.T), (st.dist_right, back.dist_right)):
+    for a, b in (
+        (st.K_left, back.K_left),
+        (st.R, back.R),
+        (st.T, back.T),
+        (st.dist_right, back.dist_right),
+    ):
         np.testing.assert_array_equal(a, b)
     data = json.loads(path.read_text())
     assert set(data) == {"image_size", "left", "right", "R", "T"}
