@@ -1,0 +1,86 @@
+"""``holecell measure``: measure one hole from a stereo image pair."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from measure import MeasureOptions, StereoCalibration, measure_hole
+from measure.errors import ImageError, MeasurementError
+
+
+def read_image(path: str, which: str) -> np.ndarray:
+    """Read an 8- or 16-bit image as single-channel (colour is converted to gray)."""
+    if not Path(path).is_file():
+        raise ImageError(which, f"{path}: no such file")
+    img = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ImageError(which, f"{path}: not a readable image")
+    if img.ndim == 3:
+        img = cv2.cvtColor(img[:, :, :3], cv2.COLOR_BGR2GRAY)
+    return img
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``measure`` subcommand."""
+    p = sub.add_parser(
+        "measure",
+        help="measure one hole from a stereo image pair",
+        description=(
+            "Reads LEFT and RIGHT images (8- or 16-bit PNG/TIFF) and the stereo calibration "
+            "(stereo.json); prints the hole's centre, axis and diameter in the left camera "
+            "frame. Writes nothing."
+        ),
+    )
+    p.add_argument("left", help="left camera image")
+    p.add_argument("right", help="right camera image")
+    p.add_argument("--stereo", required=True, help="stereo calibration file (stereo.json)")
+    p.add_argument("--diameter", type=float, default=None, help="expected diameter (metres)")
+    p.add_argument(
+        "--method",
+        choices=("default", "published"),
+        default="default",
+        help="edge/fit method: the default, or the published one (for comparison)",
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(handler=run)
+
+
+def _table(m) -> str:
+    c = m.center_m * 1e3
+    rows = [
+        ("status", m.status),
+        ("diameter", f"{m.diameter_m * 1e3:.4f} mm"),
+        ("centre (left cam)", f"{c[0]:.4f}  {c[1]:.4f}  {c[2]:.4f} mm"),
+        ("normal", "  ".join(f"{v:+.5f}" for v in m.normal)),
+        ("rms residual", f"{m.rms_m * 1e3:.4f} mm"),
+        ("σ(radius)", f"{np.sqrt(m.cov_center_radius[3, 3]) * 1e3:.5f} mm"),
+        ("points used/rejected/filled", f"{m.n_points} / {m.n_rejected} / {m.n_filled}"),
+        ("time", f"{m.time_s * 1e3:.1f} ms"),
+    ]
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Handler: measure and print; with ``--json`` errors are JSON too (exit code 2)."""
+    opts = MeasureOptions.published() if args.method == "published" else MeasureOptions()
+    try:
+        stereo = StereoCalibration.load(args.stereo)
+        left = read_image(args.left, "left")
+        right = read_image(args.right, "right")
+        m = measure_hole(left, right, stereo, expected_diameter_m=args.diameter, options=opts)
+    except MeasurementError as exc:
+        if not args.json:
+            raise
+        print(json.dumps({"status": "error", "reason": str(exc)}))
+        return 2
+    if args.json:
+        print(json.dumps(m.to_dict()))
+    else:
+        print(_table(m))
+    return 0
