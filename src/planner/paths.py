@@ -6,6 +6,12 @@ checked configurations. :class:`SegmentPlanner` returns the straight joint
 segment when it is free, else plans with OMPL's RRT-Connect (validity by the
 arm's collision check, motions by :class:`MotionChecker`) and shortcuts and
 simplifies the result.
+
+Planning first uses motion checks ``COARSE_FACTOR`` times coarser than the set
+resolution (most of the planner's checks are on edges it then discards) and
+validates the simplified path at the set resolution; only when that fails is
+the segment planned again at the set resolution. Every returned path is free
+at the set resolution.
 """
 
 from __future__ import annotations
@@ -25,6 +31,9 @@ from planner.protocols import ArmLike
 log = logging.getLogger(__name__)
 
 _seeded: list[int] = []
+
+#: motion checks during the first planning attempt are this much coarser
+COARSE_FACTOR = 4.0
 
 
 def seed_ompl(seed: int) -> None:
@@ -56,6 +65,10 @@ class MotionChecker:
         self.joint_step = joint_step_rad
         self.tcp_step = tcp_step_m
         self.checks = 0
+
+    def coarser(self, factor: float) -> MotionChecker:
+        """A checker on the same arm with ``factor`` times larger steps."""
+        return MotionChecker(self.arm, self.joint_step * factor, self.tcp_step * factor)
 
     def state_free(self, q: NDArray[np.float64]) -> bool:
         """True when ``q`` is within limits and free of collision."""
@@ -114,8 +127,8 @@ class SegmentPath:
     planned: bool
 
 
-class SegmentPlanner:
-    """Straight segment when free, else RRT-Connect + shortcutting (see module docstring)."""
+class _Space:
+    """OMPL space information whose motions are checked by one :class:`MotionChecker`."""
 
     def __init__(
         self, checker: MotionChecker, lower: NDArray[np.float64], upper: NDArray[np.float64]
@@ -142,6 +155,38 @@ class SegmentPlanner:
         s[0 : self.dof] = [float(v) for v in q]
         return s
 
+    def solve(
+        self, q_a: NDArray[np.float64], q_b: NDArray[np.float64], time_s: float
+    ) -> NDArray[np.float64] | None:
+        """RRT-Connect then simplification; the waypoints (m, dof) or ``None`` if unsolved."""
+        pdef = ob.ProblemDefinition(self.si)
+        pdef.setStartAndGoalStates(self._state(q_a), self._state(q_b))
+        planner = og.RRTConnect(self.si)
+        planner.setProblemDefinition(pdef)
+        planner.setup()
+        planner.solve(ob.timedPlannerTerminationCondition(time_s))
+        if not pdef.hasExactSolution():
+            return None
+        path = pdef.getSolutionPath()
+        simplifier = og.PathSimplifier(self.si)
+        simplifier.simplify(path, min(time_s, 0.5))
+        Q = np.array(
+            [[path.getState(k)[i] for i in range(self.dof)] for k in range(path.getStateCount())]
+        )
+        Q[0], Q[-1] = q_a, q_b
+        return Q
+
+
+class SegmentPlanner:
+    """Straight segment when free, else RRT-Connect + shortcutting (see module docstring)."""
+
+    def __init__(
+        self, checker: MotionChecker, lower: NDArray[np.float64], upper: NDArray[np.float64]
+    ) -> None:
+        self.checker = checker
+        self.coarse = _Space(checker.coarser(COARSE_FACTOR), lower, upper)
+        self.fine = _Space(checker, lower, upper)
+
     def plan(
         self,
         q_a: NDArray[np.float64],
@@ -152,22 +197,12 @@ class SegmentPlanner:
         """A free path ``q_a`` to ``q_b``, else :class:`SegmentPlanningError` naming ``names``."""
         if self.checker.segment_free(q_a, q_b):
             return SegmentPath(np.array([q_a, q_b]), planned=False)
-        pdef = ob.ProblemDefinition(self.si)
-        pdef.setStartAndGoalStates(self._state(q_a), self._state(q_b))
-        planner = og.RRTConnect(self.si)
-        planner.setProblemDefinition(pdef)
-        planner.setup()
-        status = planner.solve(ob.timedPlannerTerminationCondition(time_s))
-        if not pdef.hasExactSolution():
-            raise SegmentPlanningError(
-                *names, f"RRT-Connect found no path in {time_s:g} s ({status})"
-            )
-        path = pdef.getSolutionPath()
-        simplifier = og.PathSimplifier(self.si)
-        simplifier.simplify(path, min(time_s, 0.5))
-        Q = np.array(
-            [[path.getState(k)[i] for i in range(self.dof)] for k in range(path.getStateCount())]
-        )
-        Q[0], Q[-1] = q_a, q_b
+        Q = self.coarse.solve(q_a, q_b, time_s)
+        self.checker.checks += self.coarse.checker.checks
+        self.coarse.checker.checks = 0
+        if Q is None or not self.checker.polyline_free(Q):
+            Q = self.fine.solve(q_a, q_b, time_s)
+        if Q is None:
+            raise SegmentPlanningError(*names, f"RRT-Connect found no path in {time_s:g} s")
         log.info("segment %s -> %s: OMPL path with %d waypoints", names[0], names[1], len(Q))
         return SegmentPath(Q, planned=True)

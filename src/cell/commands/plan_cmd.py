@@ -1,0 +1,142 @@
+"""``holecell plan [CELL] -o tour.json``: plan the inspection tour of a cell.
+
+Reads CELL (a cell.yaml; default: the built-in motorcycle frame), plans the
+tour (viewpoints, sequence, paths, timing) and writes ``tour.json``. Shows a
+progress bar per stage on stderr and prints a summary on stdout.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import sys
+import time
+from pathlib import Path
+from typing import TextIO
+
+from cell.config import load_cell
+from cell.errors import CellError
+from planner import STAGES, Options, Tour, TourPlanner
+from planner.errors import OptionsError
+
+
+class StageBars:
+    """One text progress bar per planner stage (a line each; redrawn in place on a terminal)."""
+
+    WIDTH = 30
+
+    def __init__(self, stream: TextIO = sys.stderr) -> None:
+        self.stream = stream
+        self.tty = stream.isatty()
+        self.stage: str | None = None
+        self.started = time.perf_counter()
+        self.last_draw = 0.0
+
+    def _draw(self, stage: str, done: int, total: int, final: bool) -> None:
+        frac = done / total if total else 1.0
+        bar = "#" * round(frac * self.WIDTH)
+        elapsed = time.perf_counter() - self.started
+        line = f"{stage:<11s} [{bar:<{self.WIDTH}s}] {done}/{total}  {elapsed:5.2f} s"
+        if self.tty:
+            self.stream.write("\r" + line + ("\n" if final else ""))
+        elif final:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        if stage != self.stage:
+            self.stage = stage
+            self.started = time.perf_counter()
+        now = time.perf_counter()
+        final = done >= total
+        if final or now - self.last_draw > 0.05:
+            self.last_draw = now
+            self._draw(stage, done, total, final)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``plan`` subcommand."""
+    p = sub.add_parser(
+        "plan",
+        help="plan the inspection tour of a cell and write tour.json",
+        description=(
+            "Reads CELL (a cell.yaml; default: the built-in motorcycle frame) and writes the "
+            "inspection tour to OUT (tour.json): the hole order, the joint configuration at each "
+            "stop, the jerk-limited trajectory sampled at the controller period, the cycle time "
+            "and the holes left out with their reasons. Units: m, rad, s."
+        ),
+    )
+    p.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
+    p.add_argument(
+        "-o", "--output", default="tour.json", help="tour file to write (default: %(default)s)"
+    )
+    p.add_argument("--strict", action="store_true", help="fail if any hole cannot be inspected")
+    p.add_argument(
+        "--seed", type=int, default=0, help="random seed; same seed, same tour (default: 0)"
+    )
+    p.add_argument(
+        "--time-budget",
+        type=float,
+        default=None,
+        metavar="S",
+        help="cap on the sequencer's search time in s (default: 1 s + 0.03 s per hole)",
+    )
+    p.add_argument(
+        "--roll-step-deg", type=float, default=15.0, help="roll sampling about the view axis"
+    )
+    p.add_argument("--tilt-deg", type=float, default=0.0, help="half-angle of the view tilt cone")
+    p.add_argument("--dt", type=float, default=0.004, help="controller period in s")
+    p.add_argument("--dwell", type=float, default=0.2, help="rest at each stop in s")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.set_defaults(handler=run_plan)
+
+
+def _options(args: argparse.Namespace) -> Options:
+    return Options(
+        roll_step_deg=args.roll_step_deg,
+        tilt_deg=args.tilt_deg,
+        strict=args.strict,
+        seed=args.seed,
+        time_budget_s=args.time_budget,
+        dt=args.dt,
+        dwell_s=args.dwell,
+    )
+
+
+def summary(tour: Tour, path: Path) -> list[str]:
+    """Human-readable summary lines of a planned tour."""
+    lines = [
+        f"cell          {tour.cell_name}  (sha256 {tour.cell_sha256[:12]}...)",
+        f"holes         {len(tour.stops)} in the tour, {len(tour.left_out)} left out",
+    ]
+    lines += [f"  left out    {h.hole_id}: {h.reason}" for h in tour.left_out]
+    stages = "  ".join(f"{s} {tour.timings_s.get(s, 0.0):.2f}" for s in STAGES)
+    lines += [
+        f"cycle time    {tour.cycle_time_s:.2f} s  "
+        f"(dwell {tour.settings.get('dwell_s', 0.0)} s per stop)",
+        f"planning time {tour.planning_time_s:.2f} s  ({stages} s)",
+        f"trajectory    {len(tour.trajectory)} samples every {tour.dt * 1e3:g} ms, "
+        f"{tour.settings.get('ompl_segments', 0)} segment(s) planned around obstacles",
+        f"written       {path}",
+    ]
+    return lines
+
+
+def run_plan(args: argparse.Namespace) -> int:
+    """Plan and write the tour; exit 0 (complete), 1 (holes left out) or 2 (error)."""
+    out = Path(args.output)
+    if out.is_dir():
+        raise CellError(f"-o {out}: is a directory; give a file name such as tour.json")
+    if not out.parent.exists():
+        raise CellError(f"-o {out}: folder {out.parent} does not exist")
+    try:
+        options = _options(args)
+    except OptionsError as exc:
+        raise CellError(str(exc)) from exc
+    cell = load_cell(args.cell)
+    progress = None if args.quiet else StageBars()
+    tour = TourPlanner(options, progress).plan(cell)
+    gc.collect()  # free the OMPL objects now (their bindings complain if still alive at exit)
+    tour.save(out)
+    print("\n".join(summary(tour, out)))
+    return 1 if tour.left_out else 0
