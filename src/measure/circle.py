@@ -17,8 +17,8 @@ Two costs:
 
 Robustness: if less than 90 % of the points lie within 0.5 % of the radius (at least 10 µm)
 of the refined
-published start, a three-point RANSAC circle with more support replaces it; then two
-iteratively reweighted passes with Cauchy weights, then iterative rejection of points
+published start, a three-point RANSAC circle with more support replaces it, followed by
+two iteratively reweighted passes with Cauchy weights; then iterative rejection of points
 farther than
 ``reject_sigma`` robust standard deviations (MAD) from the circle, refitted with plain LM on
 the inliers. The number rejected is reported.
@@ -231,7 +231,7 @@ def fit_circle_3d(
             if support > own:
                 c, n, r = rc, rn, rr
         # two Cauchy-weighted (IRLS) passes pull the start away from remaining outliers
-        for _ in range(2):
+        for _ in range(2 if own < 0.9 else 0):
             d = orthogonal_distance(pts, c, n, r)
             s = _sigma(d, floor)
             c, n, r, *_ = _solve(pts, w / (1.0 + (d / (2.385 * s)) ** 2), c, n, r, cost)
@@ -241,14 +241,14 @@ def fit_circle_3d(
         inl = d < reject_sigma * _sigma(d, floor)
         if inl.sum() < 6:
             inl = np.ones(len(pts), dtype=bool)
-    for _ in range(6 if robust else 1):
+    for _ in range(5 if robust else 1):
         c, n, r, sol, k = _solve(pts[inl], w[inl], c, n, r, cost)
         if not robust:
             break
         d = orthogonal_distance(pts, c, n, r)
         new = d < reject_sigma * _sigma(d[inl], floor)
-        if new.sum() < 6 or np.array_equal(new, inl):
-            break
+        if new.sum() < 6 or np.count_nonzero(new != inl) <= 0.005 * len(inl):
+            break  # stable to within 0.5 % of the points
         inl = new
     if not (np.isfinite(r) and r > 0 and np.all(np.isfinite(c))):
         raise FitError(f"degenerate circle (radius {r!r})")

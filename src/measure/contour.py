@@ -55,7 +55,9 @@ def robust_ellipse(
 ) -> tuple[Ellipse, np.ndarray]:
     """``cv2.fitEllipse`` made robust by RANSAC over the ordered contour.
 
-    Each trial fits an ellipse to six points, one from each sixth of the contour, and counts
+    When 90 % of the points already lie within ``tol_px`` of the plain fit, RANSAC is
+    skipped. Otherwise each trial fits an ellipse to six points, one from each sixth of the
+    contour, and counts
     the points within ``tol_px``; the best consensus is refitted, then points within
     max(4σ, ``floor_px``) of it are the inliers. A contiguous false arc far from the rest (a
     reflection, a false edge) cannot win. A shallow dent (a burr over the rim) can look
@@ -64,7 +66,8 @@ def robust_ellipse(
     """
     n = len(pts)
     ell = cv2.fitEllipse(pts.astype(np.float32))
-    if n >= 24:
+    clean = np.count_nonzero(np.abs(ellipse_distance(pts, ell)) < tol_px) >= 0.9 * n
+    if n >= 24 and not clean:
         rng = np.random.default_rng(seed)
         bounds = np.linspace(0, n, 7).astype(int)
         best, best_score = ell, np.count_nonzero(np.abs(ellipse_distance(pts, ell)) < tol_px)
