@@ -8,7 +8,10 @@ simulation time, so a run can start on a half-warm arm.
 
 from __future__ import annotations
 
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,17 +20,43 @@ from robots.thermal.drift import DriftSettings, DriftTruth, default_settings
 
 
 class SimClock:
-    """Simulation time: ``speed`` simulation seconds per wall second, from construction."""
+    """Simulation time: ``speed`` simulation seconds per wall second, from construction.
+
+    The speed can change while running (:meth:`set_speed`, e.g. to fast-forward a warm-up), and
+    the clock can be held (:meth:`held`) while the simulator computes something that takes no
+    time in the real cell (rendering an exposure)."""
 
     def __init__(self, speed: float = 1.0) -> None:
         if not speed > 0:
             raise ValueError(f"speed {speed} must be > 0")
         self.speed = float(speed)
-        self._wall0 = time.monotonic()
+        self._base_sim = 0.0
+        self._base_wall = time.monotonic()
+        self._lock = threading.Lock()
 
     def now(self) -> float:
         """Simulation time (s) since the start."""
-        return (time.monotonic() - self._wall0) * self.speed
+        with self._lock:
+            return self._base_sim + (time.monotonic() - self._base_wall) * self.speed
+
+    def set_speed(self, speed: float) -> None:
+        """Change the speed from now on (simulation time stays continuous)."""
+        if not speed > 0:
+            raise ValueError(f"speed {speed} must be > 0")
+        with self._lock:
+            wall = time.monotonic()
+            self._base_sim += (wall - self._base_wall) * self.speed
+            self._base_wall, self.speed = wall, float(speed)
+
+    @contextmanager
+    def held(self) -> Iterator[None]:
+        """Simulation time does not advance inside this block."""
+        t = self.now()
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._base_sim, self._base_wall = t, time.monotonic()
 
     def wall_for(self, sim_s: float) -> float:
         """Wall seconds that ``sim_s`` simulation seconds take."""
@@ -61,8 +90,8 @@ class WorldOptions:
     speed: float = 1.0
     drift_offset_s: float = 1800.0
     drift: DriftSettings | None = None
-    position_sigma_m: float = 50e-6
-    diameter_sigma_m: float = 10e-6
+    position_sigma_m: float = 15e-6
+    diameter_sigma_m: float = 5e-6
     seed: int = 0
 
 

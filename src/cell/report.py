@@ -1,0 +1,110 @@
+"""``report.json`` and ``report.csv`` of a run directory, from its store.
+
+Files are in SI units (m); the printed summary is for people (mm, um). CSV columns:
+``hole_id, stop, status, nominal_x_m .. nominal_z_m, measured_x_m .. measured_z_m,
+position_deviation_m, nominal_diameter_m, diameter_m, diameter_deviation_m, tolerance_m,
+pass, u_center_m, u_diameter_m, reason`` (empty cells where a hole was not measured).
+``u_*`` are one-sigma uncertainties from the circle fit's covariance.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Any
+
+from cell.results import HoleResult
+from cell.store import Store
+
+CSV_COLUMNS = (
+    "hole_id", "stop", "status",
+    "nominal_x_m", "nominal_y_m", "nominal_z_m",
+    "measured_x_m", "measured_y_m", "measured_z_m",
+    "position_deviation_m", "nominal_diameter_m", "diameter_m", "diameter_deviation_m",
+    "tolerance_m", "pass", "u_center_m", "u_diameter_m", "reason",
+)  # fmt: skip
+
+
+def summary(store: Store) -> dict[str, Any]:
+    """Counts and extremes of a run (SI units)."""
+    info = store.run_info()
+    results = store.results()
+    planned = store.planned()
+    measured = [r for r in results if r.measured]
+    worst = max(measured, key=lambda r: r.position_deviation_m, default=None)
+    return {
+        "cell": info["cell_name"],
+        "cell_sha256": info["cell_sha256"],
+        "robot_model": info["robot_model"],
+        "state": info["state"],
+        "holes_planned": len(planned),
+        "holes_stored": len(results),
+        "holes_measured": len(measured),
+        "holes_missing": sum(r.status == "missing" for r in results),
+        "holes_failed": sum(r.status == "fail" for r in results),
+        "holes_not_reached": len(planned) - len(results),
+        "worst_position_deviation_m": worst.position_deviation_m if worst else None,
+        "worst_hole": worst.hole_id if worst else None,
+        "worst_diameter_deviation_m": max(
+            (abs(r.diameter_deviation_m) for r in measured), default=None
+        ),
+        "started_at": info["started_at"],
+        "finished_at": info["finished_at"],
+    }
+
+
+def _row(r: HoleResult) -> dict[str, Any]:
+    nom = r.nominal_part_m
+    meas = r.center_part_m or (None, None, None)
+    return {
+        "hole_id": r.hole_id,
+        "stop": r.stop_index,
+        "status": r.status,
+        "nominal_x_m": nom[0], "nominal_y_m": nom[1], "nominal_z_m": nom[2],
+        "measured_x_m": meas[0], "measured_y_m": meas[1], "measured_z_m": meas[2],
+        "position_deviation_m": r.position_deviation_m,
+        "nominal_diameter_m": r.nominal_diameter_m,
+        "diameter_m": r.diameter_m,
+        "diameter_deviation_m": r.diameter_deviation_m,
+        "tolerance_m": r.tolerance_m,
+        "pass": None if not r.measured else r.status != "fail",
+        "u_center_m": r.u_center_m,
+        "u_diameter_m": r.u_diameter_m,
+        "reason": r.reason,
+    }  # fmt: skip
+
+
+def write_report(run_dir: str | Path) -> dict[str, Any]:
+    """Write ``report.json`` and ``report.csv`` into ``run_dir``; returns the summary."""
+    run_dir = Path(run_dir)
+    with Store.open(run_dir) as store:
+        summ = summary(store)
+        rows = [_row(r) for r in store.results()]
+        events = store.events()
+    doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
+           "events": events}  # fmt: skip
+    (run_dir / "report.json").write_text(json.dumps(doc, indent=1))
+    with (run_dir / "report.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS)
+        w.writeheader()
+        for row in rows:
+            w.writerow({k: ("" if v is None else v) for k, v in row.items()})
+    return summ
+
+
+def format_summary(summ: dict[str, Any]) -> str:
+    """The human summary (mm, um)."""
+    worst = summ["worst_position_deviation_m"]
+    dia = summ["worst_diameter_deviation_m"]
+    lines = [
+        f"cell            {summ['cell']} ({summ['robot_model']})",
+        f"run state       {summ['state']}",
+        f"holes           {summ['holes_measured']} measured, {summ['holes_missing']} missing, "
+        f"{summ['holes_failed']} out of tolerance, {summ['holes_not_reached']} not reached "
+        f"(of {summ['holes_planned']} planned)",
+    ]
+    if worst is not None:
+        lines.append(f"worst position  {worst * 1e3:.4f} mm (hole {summ['worst_hole']})")
+        lines.append(f"worst diameter  {dia * 1e3:.4f} mm")
+    return "\n".join(lines)

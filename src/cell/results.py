@@ -1,0 +1,73 @@
+"""The result of inspecting one hole: what the store keeps and the report shows.
+
+Frames and units: ``*_part_m`` in the part frame (m); ``normal_part`` unit axis out of the
+surface; deviations in m; ``q_rad`` joints at capture (rad); ``temperatures_c`` sensor readings
+(degC); times in s. ``status`` is ``"ok"`` (measured, within tolerance or no tolerance),
+``"fail"`` (measured, out of tolerance), ``"suspect"`` (measured, but the measurement flags much
+filled or rejected edge) or ``"missing"`` (no hole where one should be; no measured values).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+STATUSES = ("ok", "fail", "suspect", "missing")
+
+
+@dataclass(frozen=True)
+class HoleResult:
+    """One hole, measured (or found missing) at one stop of a run."""
+
+    hole_id: str
+    stop_index: int
+    status: str
+    nominal_part_m: tuple[float, float, float]
+    nominal_diameter_m: float
+    tolerance_m: float | None
+    center_part_m: tuple[float, float, float] | None = None
+    normal_part: tuple[float, float, float] | None = None
+    diameter_m: float | None = None
+    position_deviation_m: float | None = None
+    diameter_deviation_m: float | None = None
+    u_center_m: float | None = None
+    u_diameter_m: float | None = None
+    rms_m: float | None = None
+    n_points: int | None = None
+    q_rad: tuple[float, ...] = ()
+    temperatures_c: tuple[float, ...] = ()
+    sim_time_s: float = 0.0
+    measure_time_s: float = 0.0
+    reason: str = ""
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise ValueError(f"status {self.status!r} not in {STATUSES}")
+
+    @property
+    def measured(self) -> bool:
+        """True if the hole was found and measured."""
+        return self.center_part_m is not None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready mapping (SI units)."""
+        return asdict(self)
+
+
+def deviations(
+    center_part_m: np.ndarray,
+    diameter_m: float,
+    nominal_part_m: np.ndarray,
+    nominal_diameter_m: float,
+    tolerance_m: float | None,
+) -> tuple[float, float, bool]:
+    """(position deviation (m), diameter deviation (m), pass). A hole passes when both the
+    centre distance and the absolute diameter deviation are within ``tolerance_m`` (always, if
+    the hole has no tolerance)."""
+    dpos = float(np.linalg.norm(np.asarray(center_part_m) - np.asarray(nominal_part_m)))
+    ddia = float(diameter_m - nominal_diameter_m)
+    ok = tolerance_m is None or (dpos <= tolerance_m and abs(ddia) <= tolerance_m)
+    return dpos, ddia, ok

@@ -1,0 +1,290 @@
+"""The run state machine: wait for start, thermal update on the reference targets, then for each
+stop move, settle, capture, measure, compensate, compare, store; go home.
+
+States (stored as the run's timeline): ``created`` -> ``waiting`` -> ``reference`` ->
+``inspecting`` -> ``homing`` -> ``done``; ``fault`` when the controller reports an emergency stop
+or fault, or the link stays dead beyond the reconnect budget (the arm is stopped on its path and
+the store keeps every hole measured so far). A resumed run skips every hole already stored, so
+no hole is ever stored twice and nothing stored is lost.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cell.camera import CameraBackend
+from cell.config import CellConfig
+from cell.errors import CellError
+from cell.inspect_hole import T_cell_tcp, inspect
+from cell.link import messages as m
+from cell.link.client import ControllerClient
+from cell.link.errors import LinkError, RequestRefusedError
+from cell.results import HoleResult
+from cell.reference import target_of
+from cell.store import Store
+from cell.thermal_update import ThermalUpdate
+from measure import MeasurementError, head_frame, measure_hole
+from planner import Tour
+from robots.thermal.model import ThermalModel
+from robots.transforms import invert
+
+log = logging.getLogger(__name__)
+
+
+class RunFaultError(CellError):
+    """The run stopped on a controller fault; ``state`` and ``fault`` as the controller said."""
+
+    def __init__(self, where: str, state: str, fault: str) -> None:
+        self.where, self.state, self.fault = where, state, fault
+        super().__init__(
+            f"run stopped at {where}: controller {state} ({fault}); every hole measured so far "
+            "is stored; clear the fault, then continue with --resume RUN_DIR"
+        )
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Settings of a run. Times in wall seconds unless said otherwise.
+
+    Attributes:
+        settle_s: wait after "in position" before the capture.
+        move_timeout_s: longest wait for one move.
+        reconnect_budget_s: how long a dead link is retried before the run stops.
+        reference_rounds: rounds over the reference targets before the holes (0: none).
+        reference_interval_s: controller-clock seconds between the starts of two rounds.
+        reference_c: temperature (degC) at which the nominal kinematics hold.
+    """
+
+    settle_s: float = 0.2
+    move_timeout_s: float = 120.0
+    reconnect_budget_s: float = 15.0
+    reference_rounds: int = 1
+    reference_interval_s: float = 300.0
+    reference_c: float = 20.0
+
+
+@dataclass
+class RunResult:
+    """Outcome of :meth:`Runner.run`: status (``done`` / ``fault``), holes stored by this call,
+    holes skipped as already stored, timings (s) and link counters."""
+
+    status: str
+    stored: list[HoleResult] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    timings: dict[str, float] = field(default_factory=dict)
+    link: dict[str, int] = field(default_factory=dict)
+    thermal: str = ""
+
+
+#: ``progress(event, data)`` for the CLI: events "state", "hole", "reference"
+Progress = Callable[[str, dict], None]
+
+
+def stop_rows(tour: Tour) -> list[int]:
+    """Trajectory row of every stop (arrival time / dt), checked against the stop's joints."""
+    rows = []
+    for k, s in enumerate(tour.stops):
+        r = round(s.t / tour.dt)
+        if not 0 <= r < len(tour.trajectory) or not np.allclose(tour.trajectory[r], s.q, atol=1e-6):
+            raise CellError(f"tour: stop {k} ({s.hole_id}) is not on the trajectory at t={s.t}")
+        rows.append(r)
+    return rows
+
+
+class Runner:
+    """Runs one tour of one cell on one controller, storing into one run store."""
+
+    def __init__(
+        self,
+        cell: CellConfig,
+        tour: Tour,
+        store: Store,
+        client: ControllerClient,
+        camera: CameraBackend,
+        options: RunOptions | None = None,
+        reference_tour: Tour | None = None,
+        thermal_model: ThermalModel | None = None,
+        progress: Progress | None = None,
+        recorder=None,
+    ) -> None:
+        self.cell, self.tour, self.store, self.client, self.camera = (
+            cell,
+            tour,
+            store,
+            client,
+            camera,
+        )
+        self.options = options or RunOptions()
+        self.reference_tour = reference_tour
+        self.model = thermal_model
+        self.progress = progress or (lambda event, data: None)
+        self.recorder = recorder
+        self.arm = cell.build_arm()
+        self.holes = {h.id: h for h in cell.holes_in_cell()}
+        self.thermal = ThermalUpdate(cell, self.arm, self.options.reference_c)
+        self._T_head_left = invert(head_frame(camera.stereo))
+        self._loaded: Tour | None = None
+
+    # --- the state machine -----------------------------------------------------------------
+    def run(self, wait_for_start: Callable[[], None] | None = None) -> RunResult:
+        """Run (or continue) the tour; returns when home or stopped by a fault."""
+        t0 = time.perf_counter()
+        result = RunResult("done")
+        stored = self.store.stored_ids()
+        try:
+            self._state("waiting")
+            if wait_for_start is not None:
+                wait_for_start()
+            todo = [k for k, s in enumerate(self.tour.stops) if s.hole_id not in stored]
+            result.skipped = [s.hole_id for s in self.tour.stops if s.hole_id in stored]
+            if todo and self.reference_tour is not None and self.options.reference_rounds > 0:
+                self._state("reference")
+                self._reference_phase()
+                result.thermal = self._identify()
+            self._state("inspecting")
+            self._load(self.tour)
+            for k in todo:
+                result.stored.append(self._inspect_stop(k))
+            self._state("homing")
+            self._move(len(self.tour.stops), "home")
+            self.store.set_state("done", finished=True)
+            self.progress("state", {"state": "done"})
+        except RunFaultError as exc:
+            result.status = "fault"
+            self._safe_stop()
+            self.store.set_state("fault", str(exc))
+            self.progress("state", {"state": "fault", "message": str(exc)})
+            raise
+        except LinkError as exc:
+            result.status = "fault"
+            self.store.set_state("fault", f"link lost: {exc}")
+            raise
+        finally:
+            result.timings["run_s"] = time.perf_counter() - t0
+            result.link = vars(self.client.stats).copy()
+        return result
+
+    def _state(self, state: str) -> None:
+        self.store.set_state(state)
+        self.progress("state", {"state": state})
+        if self.recorder is not None:
+            self.recorder.state(state)
+
+    # --- motion ----------------------------------------------------------------------------
+    def _load(self, tour: Tour) -> None:
+        rows = stop_rows(tour)
+        self.client.load_trajectory(tour.trajectory, rows, tour.dt)
+        self._loaded = tour
+
+    def _move(self, k: int, where: str) -> m.Status:
+        """Bring the arm to stop ``k`` of the loaded tour, surviving a dead link."""
+        deadline = time.monotonic() + self.options.move_timeout_s
+        while True:
+            try:
+                self.client.move_to_stop(k)
+                st = self.client.wait_in_position(k, self.options.move_timeout_s)
+            except LinkError as exc:
+                self._recover(exc, where)
+                continue
+            except RequestRefusedError as exc:
+                st = self.client.status()
+                if st.state in (m.State.ESTOP, m.State.FAULT):
+                    raise RunFaultError(where, st.state.name, st.fault.name) from exc
+                raise
+            if st.state == m.State.IN_POSITION and st.at_stop == k:
+                return st
+            if st.state in (m.State.ESTOP, m.State.FAULT):
+                raise RunFaultError(where, st.state.name, st.fault.name)
+            self.store.event("motion", f"{where}: {st.state.name} ({st.fault.name}), moving on")
+            if time.monotonic() > deadline:
+                raise RunFaultError(where, st.state.name, "move timed out")
+
+    def _recover(self, exc: LinkError, where: str) -> None:
+        self.store.event("link", f"{where}: {exc}; reconnecting")
+        self.client.reconnect(self.options.reconnect_budget_s)
+        if self._loaded is not None:
+            self._load(self._loaded)
+        self.store.event("link", f"{where}: link restored")
+
+    def _safe_stop(self) -> None:
+        try:
+            self.client.stop()
+        except (LinkError, RequestRefusedError) as exc:
+            self.store.event("fault", f"stop request failed: {exc}")
+
+    def _settled_status(self) -> m.Status:
+        time.sleep(self.options.settle_s)
+        return self.client.status()
+
+    # --- reference targets -----------------------------------------------------------------
+    def _reference_phase(self) -> None:
+        tour = self.reference_tour
+        self._load(tour)
+        for rnd in range(self.options.reference_rounds):
+            t_start = self.client.status().time_s
+            for k, s in enumerate(tour.stops):
+                self._move(k, f"reference {s.hole_id}")
+                st = self._settled_status()
+                pair = self.camera.capture()
+                try:
+                    meas = measure_hole(pair.left, pair.right, self.camera.stereo)
+                except MeasurementError as exc:
+                    self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
+                    continue
+                p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
+                self.thermal.add(st.time_s, target_of(s.hole_id), st.q_rad, st.temperatures_c, p_tcp)
+                self.progress("reference", {"round": rnd, "target": s.hole_id})
+            self._move(len(tour.stops), "reference home")
+            if rnd + 1 < self.options.reference_rounds:
+                self._wait_controller_time(t_start + self.options.reference_interval_s)
+
+    def _wait_controller_time(self, t_s: float) -> None:
+        while self.client.status().time_s < t_s:
+            time.sleep(0.01)
+
+    def _identify(self) -> str:
+        model = self.thermal.identify()
+        if model is None:
+            msg = f"thermal model not updated: {self.thermal.refusal}"
+        else:
+            self.model = model
+            r = self.thermal.result
+            msg = (
+                f"thermal model identified from {r.n_rows} rows: terms {', '.join(r.report.kept)};"
+                f" residual {r.residual_rms_m * 1e6:.1f} um"
+                f" (before {r.residual_rms_before_m * 1e6:.1f} um)"
+            )
+        self.store.event("thermal", msg)
+        return msg
+
+    # --- one hole --------------------------------------------------------------------------
+    def _inspect_stop(self, k: int) -> HoleResult:
+        stop = self.tour.stops[k]
+        self._move(k, f"stop {k} ({stop.hole_id})")
+        st = self._settled_status()
+        pair = self.camera.capture()
+        hole = self.holes[stop.hole_id]
+        result, meas = inspect(
+            self.cell,
+            self.arm,
+            self.model,
+            self.camera.stereo,
+            hole,
+            k,
+            pair.left,
+            pair.right,
+            st.q_rad,
+            st.temperatures_c,
+            st.time_s,
+        )
+        self.store.record_hole(result)
+        if self.recorder is not None:
+            T = T_cell_tcp(self.arm, self.model, st.q_rad, st.temperatures_c)
+            self.recorder.hole(result, meas, pair, st, T @ self._T_head_left)
+        self.progress("hole", {"stop": k, "result": result})
+        return result

@@ -1,0 +1,108 @@
+"""The simulated stereo head: renders each capture from the simulator's truth.
+
+At the moment of the trigger it takes the controller's actual joints and the simulation time,
+computes the TRUE (thermally drifted) camera pose, finds the true hole or reference target in
+front of the head, and renders the pair with :func:`measure.synth.render_hole_pair` (a reference
+target with :func:`measure.synth.render_reference_pair`). A missing hole renders the bare surface.
+"""
+
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from cell.camera import StereoPair
+from cell.sim.controller import SimController
+from cell.sim.world import SimWorld, TrueHole
+from measure import StereoCalibration, head_frame
+from measure.synth import RenderOptions, render_hole_pair, render_reference_pair
+from robots.transforms import invert
+
+#: a feature counts as "in front of the head" within this distance of the view axis (m)
+VIEW_AXIS_TOL_M = 0.02
+
+
+@dataclass(frozen=True)
+class CaptureTruth:
+    """What was really in front of the head at a capture (for tests and the demo's error)."""
+
+    feature_id: str | None
+    kind: str  # "hole", "reference", "missing" or "none"
+    T_cell_left: np.ndarray
+    center_cell_m: np.ndarray | None
+    diameter_m: float | None
+
+
+class SimCamera:
+    """A :class:`cell.camera.CameraBackend` rendering from a :class:`SimWorld`."""
+
+    def __init__(
+        self,
+        world: SimWorld,
+        controller: SimController,
+        stereo: StereoCalibration,
+        missing_holes: tuple[str, ...] = (),
+        render: RenderOptions | None = None,
+        seed: int = 0,
+    ) -> None:
+        self.world = world
+        self.controller = controller
+        self.stereo = stereo
+        self.missing = set(missing_holes)
+        self.render = render or RenderOptions()
+        self._T_head_left = invert(head_frame(stereo))
+        self._seed = seed
+        self.captures = 0
+        self.last_truth: CaptureTruth | None = None
+        self.references = {
+            r.id: TrueHole(r.id, np.array(r.position, float), np.array(r.normal, float), r.diameter)
+            for r in world.cell.reference_targets
+        }
+
+    def capture(self) -> StereoPair:
+        """Render the pair the head sees now (an exposure takes no simulation time)."""
+        with self.world.clock.held():
+            return self._capture(self.world.clock.now())
+
+    def _capture(self, t: float) -> StereoPair:
+        T_cell_left = self.world.true_T_cell_tcp(self.controller.q_rad(), t) @ self._T_head_left
+        T_left_cell = invert(T_cell_left)
+        kind, feature = self._in_view(T_left_cell)
+        key = feature.id if feature is not None else "none"
+        seed = (self._seed * 1_000_003 + zlib.crc32(key.encode())) & 0x7FFFFFFF
+        self.captures += 1
+        if feature is None:  # bare surface facing the head, no hole anywhere near the view
+            pair = render_hole_pair(self.stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
+            self.last_truth = CaptureTruth(None, "none", T_cell_left, None, None)
+            return StereoPair(pair.left, pair.right)
+        c = T_left_cell[:3, :3] @ feature.position_m + T_left_cell[:3, 3]
+        n = T_left_cell[:3, :3] @ feature.normal
+        if kind == "missing":  # the surface is there, the hole is not: render it far off-view
+            u = np.cross(n, [1.0, 0.0, 0.0])
+            c = c + 5.0 * u / np.linalg.norm(u)
+        fn = render_reference_pair if kind == "reference" else render_hole_pair
+        pair = fn(self.stereo, c, n, feature.diameter_m, self.render, seed)
+        self.last_truth = CaptureTruth(
+            feature.id, kind, T_cell_left, feature.position_m.copy(), feature.diameter_m
+        )
+        return StereoPair(pair.left, pair.right)
+
+    def _in_view(self, T_left_cell: np.ndarray) -> tuple[str, TrueHole | None]:
+        T_head_cell = invert(self._T_head_left) @ T_left_cell
+        best: tuple[float, str, TrueHole | None] = (VIEW_AXIS_TOL_M, "none", None)
+        candidates = [("hole", h) for h in self.world.holes.values()]
+        candidates += [("reference", r) for r in self.references.values()]
+        for kind, f in candidates:
+            p = T_head_cell[:3, :3] @ f.position_m + T_head_cell[:3, 3]
+            lateral = float(np.hypot(p[0], p[1]))
+            if p[2] > 0 and lateral < best[0]:
+                best = (lateral, kind, f)
+        _, kind, feature = best
+        if feature is not None and kind == "hole" and feature.id in self.missing:
+            kind = "missing"
+        return kind, feature
+
+    def close(self) -> None:
+        """Nothing to release."""

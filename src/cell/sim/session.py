@@ -1,0 +1,74 @@
+"""A whole simulated cell in one object: truth, controller served on a pty or socket, stereo head.
+
+``SimCell(cell, ...)`` builds :class:`SimWorld`, :class:`SimController`, :class:`SimServer` and
+:class:`SimCamera`; ``url`` is the port the runner opens, ``camera`` the head it triggers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from cell.config import CellConfig
+from cell.sim.camera import SimCamera
+from cell.sim.controller import SimController
+from cell.sim.faults import FaultPlan
+from cell.sim.server import SimServer
+from cell.sim.world import SimWorld, WorldOptions
+from measure import StereoCalibration
+from measure.synth import RenderOptions, standard_stereo
+
+
+def cell_stereo(cell: CellConfig) -> StereoCalibration:
+    """The cell's stereo calibration file, or the standard head when the cell names none."""
+    path = cell.calibration_path()
+    return StereoCalibration.load(path) if path is not None else standard_stereo()
+
+
+@dataclass
+class SimCell:
+    """A running simulated cell. Close it (or use ``with``) to stop the controller thread."""
+
+    world: SimWorld
+    controller: SimController
+    server: SimServer
+    camera: SimCamera
+
+    @classmethod
+    def start(
+        cls,
+        cell: CellConfig,
+        world: WorldOptions | None = None,
+        faults: FaultPlan | None = None,
+        transport: str = "pty",
+        link_timeout_s: float = 1.0,
+        render: RenderOptions | None = None,
+    ) -> SimCell:
+        """Build and start the simulated cell."""
+        faults = faults or FaultPlan()
+        w = SimWorld(cell, world)
+        ctrl = SimController(
+            w.clock,
+            w.temperatures,
+            cell.robot.model,
+            cell.home_q(),
+            estop_at_stop=faults.estop_at_stop,
+            link_timeout_s=link_timeout_s,
+        )
+        server = SimServer(ctrl, faults, transport).start()
+        cam = SimCamera(w, ctrl, cell_stereo(cell), faults.missing_holes, render, faults.seed)
+        return cls(w, ctrl, server, cam)
+
+    @property
+    def url(self) -> str:
+        """The port URL the runner opens."""
+        return self.server.url
+
+    def close(self) -> None:
+        """Stop the controller and release the port."""
+        self.server.close()
+
+    def __enter__(self) -> SimCell:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

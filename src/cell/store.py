@@ -1,0 +1,217 @@
+"""The results store of a run: ``results.sqlite`` in the run directory (SQLite, WAL mode).
+
+Tables: ``meta`` (schema version), ``run`` (one row: cell name, SHA-256 and text of the cell file,
+the tour file's text, port, state, times), ``holes`` (every planned hole with its stop index and
+nominal geometry), ``measurements`` (at most one row per hole: a UNIQUE key makes storing a hole
+twice impossible), ``events`` (run state changes, faults, retries, thermal updates).
+
+Each hole is stored in one transaction, so a killed process leaves every hole either fully
+stored or not at all. Opening checks the schema and the file's integrity first and refuses a
+corrupt or foreign file without writing to it.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+import time
+from pathlib import Path
+from typing import Any
+
+from cell.errors import CellError
+from cell.results import HoleResult
+
+SCHEMA_VERSION = 1
+FILENAME = "results.sqlite"
+
+_SCHEMA = """
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE run (
+    id INTEGER PRIMARY KEY CHECK (id = 1),
+    cell_name TEXT NOT NULL, cell_sha256 TEXT NOT NULL, cell_text TEXT NOT NULL,
+    tour_text TEXT NOT NULL, robot_model TEXT NOT NULL, port TEXT NOT NULL,
+    state TEXT NOT NULL, started_at REAL NOT NULL, finished_at REAL
+);
+CREATE TABLE holes (
+    hole_id TEXT PRIMARY KEY, stop_index INTEGER NOT NULL UNIQUE,
+    nominal_json TEXT NOT NULL
+);
+CREATE TABLE measurements (
+    hole_id TEXT PRIMARY KEY REFERENCES holes(hole_id),
+    stop_index INTEGER NOT NULL, status TEXT NOT NULL, result_json TEXT NOT NULL,
+    stored_at REAL NOT NULL
+);
+CREATE TABLE events (
+    id INTEGER PRIMARY KEY AUTOINCREMENT, t_wall REAL NOT NULL, kind TEXT NOT NULL,
+    state TEXT NOT NULL, message TEXT NOT NULL, data_json TEXT NOT NULL
+);
+"""
+
+
+class StoreError(CellError):
+    """The store cannot be created or used (exists already, corrupt, foreign, duplicate hole)."""
+
+    def __init__(self, path: str | Path, reason: str) -> None:
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(f"{path}: {reason}")
+
+
+class Store:
+    """A run's results store. Create with :meth:`create`, reopen with :meth:`open`."""
+
+    def __init__(self, path: Path, con: sqlite3.Connection) -> None:
+        self.path = path
+        self._con = con
+
+    @classmethod
+    def create(
+        cls,
+        run_dir: str | Path,
+        *,
+        cell_name: str,
+        cell_sha256: str,
+        cell_text: str,
+        tour_text: str,
+        robot_model: str,
+        port: str,
+        holes: list[tuple[str, int, dict[str, Any]]],
+    ) -> Store:
+        """A new store in ``run_dir`` with the planned ``holes`` (id, stop index, nominal)."""
+        path = Path(run_dir) / FILENAME
+        if path.exists():
+            raise StoreError(path, "a run is stored here already; use --resume or another --out")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        con = _connect(path)
+        with con:
+            con.executescript(_SCHEMA)
+            con.execute("INSERT INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
+            con.execute(
+                "INSERT INTO run VALUES (1, ?, ?, ?, ?, ?, ?, 'created', ?, NULL)",
+                (cell_name, cell_sha256, cell_text, tour_text, robot_model, port, time.time()),
+            )
+            con.executemany(
+                "INSERT INTO holes VALUES (?, ?, ?)",
+                [(h, k, json.dumps(nom)) for h, k, nom in holes],
+            )
+        return cls(path, con)
+
+    @classmethod
+    def open(cls, run_dir: str | Path) -> Store:
+        """Reopen the store of ``run_dir``; refuses a missing, corrupt or foreign file."""
+        path = Path(run_dir) / FILENAME
+        if not path.is_file():
+            raise StoreError(path, "no results store here (not a run directory)")
+        try:
+            con = sqlite3.connect(f"file:{path}?mode=rw", uri=True, isolation_level=None)
+            check = con.execute("PRAGMA quick_check").fetchone()[0]
+            if check != "ok":
+                raise StoreError(path, f"the store is corrupt ({check}); it was not modified")
+            version = con.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(path, f"not a readable holecell store ({exc}); not modified") from exc
+        if version is None or version[0] != str(SCHEMA_VERSION):
+            raise StoreError(path, f"schema version {version} is not {SCHEMA_VERSION}")
+        con.close()
+        return cls(path, _connect(path))
+
+    def close(self) -> None:
+        """Close the database (checkpointing the WAL)."""
+        self._con.close()
+
+    def __enter__(self) -> Store:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- run --------------------------------------------------------------------------------
+    def run_info(self) -> dict[str, Any]:
+        """The run row as a mapping."""
+        cur = self._con.execute("SELECT * FROM run WHERE id = 1")
+        row = cur.fetchone()
+        return dict(zip([c[0] for c in cur.description], row, strict=True))
+
+    def set_state(self, state: str, message: str = "", finished: bool = False) -> None:
+        """Record a run state change (and an event for the timeline)."""
+        with self._con:
+            self._con.execute("UPDATE run SET state = ? WHERE id = 1", (state,))
+            if finished:
+                self._con.execute("UPDATE run SET finished_at = ? WHERE id = 1", (time.time(),))
+            self._insert_event("state", state, message, {})
+
+    def event(self, kind: str, message: str, data: dict[str, Any] | None = None) -> None:
+        """Record an event (fault, retry, reconnect, thermal update...)."""
+        state = self.run_info()["state"]
+        with self._con:
+            self._insert_event(kind, state, message, data or {})
+
+    def _insert_event(self, kind: str, state: str, message: str, data: dict[str, Any]) -> None:
+        self._con.execute(
+            "INSERT INTO events (t_wall, kind, state, message, data_json) VALUES (?, ?, ?, ?, ?)",
+            (time.time(), kind, state, message, json.dumps(data)),
+        )
+
+    def events(self) -> list[dict[str, Any]]:
+        """Every event in order."""
+        rows = self._con.execute(
+            "SELECT t_wall, kind, state, message, data_json FROM events ORDER BY id"
+        ).fetchall()
+        return [
+            {"t_wall": t, "kind": k, "state": s, "message": msg, "data": json.loads(d)}
+            for t, k, s, msg, d in rows
+        ]
+
+    # --- holes ------------------------------------------------------------------------------
+    def planned(self) -> list[tuple[str, int, dict[str, Any]]]:
+        """(hole id, stop index, nominal) of every planned hole, in stop order."""
+        rows = self._con.execute(
+            "SELECT hole_id, stop_index, nominal_json FROM holes ORDER BY stop_index"
+        ).fetchall()
+        return [(h, k, json.loads(n)) for h, k, n in rows]
+
+    def stored_ids(self) -> set[str]:
+        """Ids of the holes already stored."""
+        return {r[0] for r in self._con.execute("SELECT hole_id FROM measurements")}
+
+    def record_hole(self, result: HoleResult) -> None:
+        """Store one hole in one transaction; storing a hole twice raises :class:`StoreError`."""
+        try:
+            with self._con:
+                self._con.execute(
+                    "INSERT INTO measurements VALUES (?, ?, ?, ?, ?)",
+                    (
+                        result.hole_id,
+                        result.stop_index,
+                        result.status,
+                        json.dumps(result.to_dict()),
+                        time.time(),
+                    ),
+                )
+        except sqlite3.IntegrityError as exc:
+            raise StoreError(
+                self.path, f"hole {result.hole_id!r} is already stored or not planned ({exc})"
+            ) from exc
+
+    def results(self) -> list[HoleResult]:
+        """Every stored hole, in stop order."""
+        rows = self._con.execute(
+            "SELECT result_json FROM measurements ORDER BY stop_index"
+        ).fetchall()
+        out = []
+        for (text,) in rows:
+            d = json.loads(text)
+            for key in ("nominal_part_m", "center_part_m", "normal_part", "q_rad"):
+                if d.get(key) is not None:
+                    d[key] = tuple(d[key])
+            d["temperatures_c"] = tuple(d["temperatures_c"])
+            out.append(HoleResult(**d))
+        return out
+
+
+def _connect(path: Path) -> sqlite3.Connection:
+    con = sqlite3.connect(str(path))
+    con.execute("PRAGMA journal_mode=WAL")
+    con.execute("PRAGMA synchronous=FULL")
+    con.execute("PRAGMA foreign_keys=ON")
+    return con

@@ -1,0 +1,91 @@
+"""The thermal update of a run: reference-target observations in, a thermal model out.
+
+Each measured reference target gives one observation row (time, target, joints, sensor readings,
+target position in the TCP frame), the format of :mod:`robots.thermal.observations`. After a
+reference round the runner identifies a model from every row so far with
+:func:`robots.thermal.identify.identify`; what the data cannot determine is refused there and
+reported here. Sensors: six readings are taken as one sensor per joint (link i -> sensor i);
+any other count as sensors shared by every link (link -> sensor 0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cell.config import CellConfig
+from robots import Arm
+from robots.thermal.errors import ThermalError
+from robots.thermal.identify import IdentificationResult, identify
+from robots.thermal.model import ThermalModel, ThermalSpec
+from robots.thermal.observations import CellGeometry, Observations
+
+
+def sensor_spec(n_sensors: int, reference_c: float) -> ThermalSpec:
+    """The sensor-to-link map for ``n_sensors`` readings with every reference at ``reference_c``."""
+    if n_sensors == 6:
+        names, links = tuple(f"j{i}" for i in range(1, 7)), tuple(range(6))
+    else:
+        names, links = tuple(f"t{i}" for i in range(1, n_sensors + 1)), (0,) * 6
+    return ThermalSpec(names, links, (reference_c,) * n_sensors)
+
+
+@dataclass
+class ThermalUpdate:
+    """Collects reference observations of a run and identifies the model from them."""
+
+    cell: CellConfig
+    arm: Arm
+    reference_c: float = 20.0
+    rows: list[tuple[float, str, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
+    result: IdentificationResult | None = None
+    refusal: str = ""
+
+    def add(self, t_s: float, target: str, q: np.ndarray, temps: np.ndarray, p_tcp: np.ndarray):
+        """One observation: target ``target`` seen at ``p_tcp`` (m, TCP frame)."""
+        self.rows.append(
+            (
+                float(t_s),
+                target,
+                np.asarray(q, float),
+                np.asarray(temps, float),
+                np.asarray(p_tcp, float),
+            )
+        )
+
+    def observations(self) -> Observations:
+        """The rows so far as :class:`Observations`."""
+        t, ids, q, temps, p = zip(*self.rows, strict=True)
+        spec = sensor_spec(len(temps[0]), self.reference_c)
+        return Observations(
+            np.array(t),
+            tuple(ids),
+            np.array(q),
+            np.array(temps),
+            spec.sensor_names,
+            np.array(p),
+            source="run reference targets",
+        )
+
+    def identify(self) -> ThermalModel | None:
+        """Identify from every row so far; None (``refusal`` says why) if nothing identifiable."""
+        if not self.rows:
+            self.refusal = "no reference observations"
+            return None
+        obs = self.observations()
+        geometry = CellGeometry(
+            self.arm.T_cell_base,
+            self.arm.T_tool0_tcp,
+            {r.id: np.asarray(r.position, float) for r in self.cell.reference_targets},
+        )
+        spec = sensor_spec(obs.temps_degC.shape[1], self.reference_c)
+        try:
+            self.result = identify(
+                obs, geometry, self.arm.dh, spec, robot_model=self.cell.robot.model
+            )
+        except ThermalError as exc:
+            self.refusal = str(exc)
+            return None
+        self.refusal = ""
+        return self.result.model
