@@ -145,10 +145,10 @@ class GtspLns:
             nodes.insert(e, int(cand[c]))
         return order
 
-    def run(self, settings: LnsSettings) -> LnsResult:
-        """Search from the greedy tour; returns the best tour found."""
+    def run(self, settings: LnsSettings, start: list[int] | None = None) -> LnsResult:
+        """Search from ``start`` (a hole order) or the greedy tour; returns the best tour found."""
         started = time.perf_counter()
-        cur = best = self.initial()
+        cur = best = self.initial() if start is None else self._local(*self._rechoose(list(start)))
         n = len(self.groups)
         since_best, hit, iterations = 0, False, 0
         for it in range(settings.max_iterations):

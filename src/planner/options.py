@@ -24,11 +24,17 @@ class Options:
         effort: work of the search relative to the default (iterations and patience scale with it).
         nodes_per_hole: candidate configurations per hole the search works with (the final
             choice of configuration for the found order considers every candidate).
+        sequencer: ``"lns"`` (large-neighbourhood search, default) or ``"ortools"``
+            (OR-Tools routing with one disjunction per hole).
     Paths:
         joint_step_deg: collision checks along a motion at least every this joint change (deg).
         tcp_step_m: ... and at least every this TCP displacement (m).
         segment_time_s: OMPL time budget per segment (s); an unsolved segment is an error.
+        refine_rounds: times the measured duration of segments that needed a detour is fed
+            back to the sequencer, which then re-sequences from the current tour.
     Timing:
+        pass_through_waypoints: fly through the waypoints of an OMPL path where the sampled
+            motion stays collision-free (else every waypoint is a stop).
         dt: controller period at which the trajectory is sampled (s).
         dwell_s: rest at each stop for settling and capture (s).
     """
@@ -41,9 +47,12 @@ class Options:
     time_budget_s: float | None = None
     effort: float = 1.0
     nodes_per_hole: int = 16
+    sequencer: str = "lns"
     joint_step_deg: float = 0.5
     tcp_step_m: float = 0.002
     segment_time_s: float = 2.0
+    refine_rounds: int = 3
+    pass_through_waypoints: bool = True
     dt: float = 0.004
     dwell_s: float = 0.2
 
@@ -66,8 +75,12 @@ class Options:
             raise OptionsError("tilt_deg", self.tilt_deg, "must lie in [0, 90)")
         if self.tilt_azimuths < 1:
             raise OptionsError("tilt_azimuths", self.tilt_azimuths, "must be at least 1")
+        if self.refine_rounds < 0:
+            raise OptionsError("refine_rounds", self.refine_rounds, "must be zero or positive")
         if self.nodes_per_hole < 1:
             raise OptionsError("nodes_per_hole", self.nodes_per_hole, "must be at least 1")
+        if self.sequencer not in ("lns", "ortools"):
+            raise OptionsError("sequencer", self.sequencer, "must be 'lns' or 'ortools'")
         if self.dwell_s < 0 or not math.isfinite(self.dwell_s):
             raise OptionsError("dwell_s", self.dwell_s, "must be zero or positive")
         if self.time_budget_s is not None and not self.time_budget_s > 0:

@@ -20,10 +20,11 @@ from scipy.spatial.transform import Rotation
 
 from planner.errors import NoReachableHoleError, StartConfigurationError, UnreachableHoleError
 from planner.options import Options
-from planner.paths import MotionChecker, SegmentPath, SegmentPlanner, seed_ompl
+from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
-from planner.sequence import SequenceResult, sequence
-from planner.timing import JointLimits, TimedMotion, rest_to_rest, time_path
+from planner.segments import Segment, SegmentCache
+from planner.sequence import GtspSequencer, SequenceResult
+from planner.timing import JointLimits, TimedMotion
 from planner.tour import LeftOut, Stop, Tour
 from planner.trajectory import Dwell, sample_timeline
 from planner.viewpoints import HoleCandidates, hole_candidates
@@ -31,6 +32,8 @@ from planner.viewpoints import HoleCandidates, hole_candidates
 log = logging.getLogger(__name__)
 
 ProgressCallback = Callable[[str, int, int], None]
+#: a replacement sequencer: (home q, candidates per hole, limits) -> SequenceResult
+Sequencer = Callable[[NDArray[np.float64], list[HoleCandidates], JointLimits], SequenceResult]
 STAGES = ("viewpoints", "sequence", "paths", "timing")
 
 
@@ -59,13 +62,24 @@ class _Route:
 
 
 class TourPlanner:
-    """Plans inspection tours with fixed :class:`Options`; :meth:`plan` does one cell."""
+    """Plans inspection tours with fixed :class:`Options`; :meth:`plan` does one cell.
+
+    ``sequencer`` replaces the built-in sequencing stage (benchmarks use it to run
+    other methods through the same viewpoints, paths and timing); ``sequencer_name``
+    is recorded in the tour's settings.
+    """
 
     def __init__(
-        self, options: Options | None = None, progress: ProgressCallback | None = None
+        self,
+        options: Options | None = None,
+        progress: ProgressCallback | None = None,
+        sequencer: Sequencer | None = None,
+        sequencer_name: str = "custom",
     ) -> None:
         self.options = options or Options()
         self.progress = progress or _no_progress
+        self.sequencer = sequencer
+        self.sequencer_name = sequencer_name if sequencer else self.options.sequencer
 
     def _home(self, arm: ArmLike, cell: CellLike) -> NDArray[np.float64]:
         home = np.asarray(cell.home_q(), dtype=float)
@@ -100,59 +114,100 @@ class TourPlanner:
             log.warning("hole %s left out: %s", h.hole_id, h.reason)
         return found, left
 
-    def _sequence(
-        self, home: NDArray[np.float64], cands: list[HoleCandidates], limits: JointLimits
-    ) -> tuple[_Route, SequenceResult]:
-        o = self.options
-        self.progress("sequence", 0, 1)
-        res = sequence(
-            home,
-            [c.q for c in cands],
-            limits,
-            time_budget_s=o.budget_s(len(cands)),
-            seed=o.seed,
-            nodes_per_hole=o.nodes_per_hole,
-            effort=o.effort,
+    def _route(self, cands: list[HoleCandidates], res: SequenceResult) -> _Route:
+        pairs = list(zip(res.order, res.choice, strict=True))
+        return _Route(
+            hole_ids=[cands[h].hole_id for h, _ in pairs],
+            q=np.array([cands[h].q[c] for h, c in pairs]),
+            branch=[int(cands[h].branch[c]) for h, c in pairs],
+            candidates=[cands[h] for h, _ in pairs],
         )
-        self.progress("sequence", 1, 1)
-        route = _Route(
-            hole_ids=[cands[h].hole_id for h in res.order],
-            q=np.array([cands[h].q[c] for h, c in zip(res.order, res.choice, strict=True)]),
-            branch=[int(cands[h].branch[c]) for h, c in zip(res.order, res.choice, strict=True)],
-            candidates=[cands[h] for h in res.order],
-        )
-        return route, res
 
-    def _paths(
-        self, home: NDArray[np.float64], route: _Route, checker: MotionChecker, limits: JointLimits
-    ) -> list[SegmentPath]:
-        seed_ompl(self.options.seed)
-        planner = SegmentPlanner(checker, limits.lower, limits.upper)
+    def _segments(
+        self, home: NDArray[np.float64], route: _Route, cache: SegmentCache
+    ) -> list[Segment]:
         points = [home, *route.q, home]
         names = ["home", *route.hole_ids, "home"]
-        paths = []
+        out = []
         for k in range(len(points) - 1):
-            paths.append(
-                planner.plan(
-                    points[k], points[k + 1], self.options.segment_time_s, (names[k], names[k + 1])
+            out.append(cache.get(points[k], points[k + 1], (names[k], names[k + 1])))
+            self.progress("paths", k + 1, len(points) - 1)
+        return out
+
+    def _sequence_and_paths(
+        self,
+        home: NDArray[np.float64],
+        cands: list[HoleCandidates],
+        limits: JointLimits,
+        cache: SegmentCache,
+        timings: dict[str, float],
+    ) -> tuple[_Route, list[Segment], SequenceResult, int]:
+        """Sequence, plan the segments, feed measured detours back, re-sequence (see Options)."""
+        o = self.options
+        t = time.perf_counter()
+        self.progress("sequence", 0, 1)
+        if self.sequencer is not None:
+            res = self.sequencer(home, cands, limits)
+            seqr = None
+        else:
+            seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
+            res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort)
+        self.progress("sequence", 1, 1)
+        timings["sequence"] = time.perf_counter() - t
+        rounds = 0
+        while True:
+            route = self._route(cands, res)
+            segments = self._segments(home, route, cache)
+            if seqr is None or res.nodes is None or rounds >= o.refine_rounds:
+                return route, segments, res, rounds
+            path_nodes = [0, *res.nodes, 0]
+            measured = {
+                (path_nodes[k], path_nodes[k + 1]): seg.motion.duration
+                for k, seg in enumerate(segments)
+                if seg.path.planned and (path_nodes[k], path_nodes[k + 1]) not in seqr.learned
+            }
+            if not measured:
+                return route, segments, res, rounds
+            rounds += 1
+            t = time.perf_counter()
+            seqr.learn(measured)
+            new = seqr.solve(o.budget_s(len(cands)), o.seed + rounds, o.effort, warm=res.nodes)
+            timings["sequence"] += time.perf_counter() - t
+            if new.nodes == res.nodes:
+                return route, segments, new, rounds
+            res = new
+
+    def _stops(
+        self, arm: ArmLike, route: _Route, segments: list[Segment]
+    ) -> tuple[list[Stop], list[TimedMotion | Dwell], float]:
+        o = self.options
+        timeline: list[TimedMotion | Dwell] = []
+        stops: list[Stop] = []
+        clock = 0.0
+        for k, seg in enumerate(segments):
+            timeline.append(seg.motion)
+            clock += seg.motion.duration
+            if k == len(route.hole_ids):
+                break
+            q = route.q[k]
+            T = arm.fk(q, "tcp")
+            pose = {
+                "xyz": [float(v) for v in T[:3, 3]],
+                "quat_xyzw": [float(v) for v in Rotation.from_matrix(T[:3, :3]).as_quat()],
+            }
+            stops.append(
+                Stop(
+                    route.hole_ids[k],
+                    tuple(float(v) for v in q),
+                    clock,
+                    o.dwell_s,
+                    pose,
+                    route.branch[k],
                 )
             )
-            self.progress("paths", k + 1, len(points) - 1)
-        return paths
-
-    def _timing(
-        self, paths: list[SegmentPath], checker: MotionChecker, limits: JointLimits
-    ) -> list[TimedMotion]:
-        motions = []
-        for k, path in enumerate(paths):
-            if path.planned:
-                motions.append(
-                    time_path(path.waypoints, limits, checker.polyline_free, self.options.dt)
-                )
-            else:
-                motions.append(rest_to_rest(path.waypoints[0], path.waypoints[-1], limits))
-            self.progress("timing", k + 1, len(paths))
-        return motions
+            timeline.append(Dwell(q, o.dwell_s))
+            clock += o.dwell_s
+        return stops, timeline, clock
 
     def plan(self, cell: CellLike) -> Tour:
         """Plan the tour of ``cell`` (see module docstring). Raises :class:`PlanningError`."""
@@ -163,51 +218,25 @@ class TourPlanner:
         limits = JointLimits.from_arm(arm)
         home = self._home(arm, cell)
         checker = MotionChecker(arm, np.radians(o.joint_step_deg), o.tcp_step_m)
-
+        cache = SegmentCache(
+            checker, limits, o.seed, o.segment_time_s, o.dt, o.pass_through_waypoints
+        )
         t = time.perf_counter()
         cands, left = self._viewpoints(arm, cell)
         timings["viewpoints"] = time.perf_counter() - t
+        route, segments, seq, rounds = self._sequence_and_paths(home, cands, limits, cache, timings)
+        timings["paths"] = cache.path_time_s
         t = time.perf_counter()
-        route, seq = self._sequence(home, cands, limits)
-        timings["sequence"] = time.perf_counter() - t
-        t = time.perf_counter()
-        paths = self._paths(home, route, checker, limits)
-        timings["paths"] = time.perf_counter() - t
-        t = time.perf_counter()
-        motions = self._timing(paths, checker, limits)
-        timeline: list[TimedMotion | Dwell] = []
-        stops: list[Stop] = []
-        clock = 0.0
-        for k, motion in enumerate(motions):
-            timeline.append(motion)
-            clock += motion.duration
-            if k < len(route.hole_ids):
-                q = route.q[k]
-                T = arm.fk(q, "tcp")
-                pose = {
-                    "xyz": [float(v) for v in T[:3, 3]],
-                    "quat_xyzw": [float(v) for v in Rotation.from_matrix(T[:3, :3]).as_quat()],
-                }
-                stops.append(
-                    Stop(
-                        hole_id=route.hole_ids[k],
-                        q=tuple(float(v) for v in q),
-                        t=clock,
-                        dwell_s=o.dwell_s,
-                        tcp_pose=pose,
-                        branch=route.branch[k],
-                    )
-                )
-                timeline.append(Dwell(q, o.dwell_s))
-                clock += o.dwell_s
+        stops, timeline, cycle = self._stops(arm, route, segments)
         trajectory = sample_timeline(timeline, o.dt)
-        timings["timing"] = time.perf_counter() - t
-        planning = time.perf_counter() - started
+        self.progress("timing", 1, 1)
+        timings["timing"] = cache.timing_time_s + time.perf_counter() - t
         settings = o.to_dict() | {
-            "sequencer": "lns",
+            "sequencer": self.sequencer_name,
             "sequence_cost_s": seq.cost_s,
             "sequence_hit_time_limit": seq.hit_time_limit,
-            "ompl_segments": sum(p.planned for p in paths),
+            "refine_rounds_used": rounds,
+            "ompl_segments": sum(s.path.planned for s in segments),
             "collision_checks": checker.checks,
         }
         return Tour(
@@ -220,8 +249,8 @@ class TourPlanner:
             left_out=left,
             dt=o.dt,
             trajectory=trajectory,
-            cycle_time_s=clock,
-            planning_time_s=planning,
+            cycle_time_s=cycle,
+            planning_time_s=time.perf_counter() - started,
             timings_s=timings,
             settings=settings,
         )

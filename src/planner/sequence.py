@@ -1,16 +1,17 @@
 """Tour sequencing: a generalised TSP over the candidate configurations of each hole.
 
 One configuration per hole, each hole once, from home back to home, minimising
-the sum of rest-to-rest travel times (:mod:`planner.costs`). OR-Tools routing
-solves it with one mandatory disjunction per hole over that hole's candidate
-configurations (at most ``max_nodes_per_hole`` of them, chosen far apart in
-travel time). The order it returns is then refined exactly over *all*
-candidates of each hole by a layered shortest path (dynamic programming).
+the sum of travel times (:mod:`planner.costs`: ruckig's rest-to-rest duration,
+computed in closed form; measured durations replace it for segments that needed
+a detour, see :meth:`GtspSequencer.learn`). Each hole contributes at most
+``nodes_per_hole`` candidate configurations, chosen far apart in travel time.
 
-The search is deterministic for a seed: OR-Tools stops after a number of
-local-search solutions that depends on the problem size and the time budget,
-not on the clock; the time budget is a hard cap that only binds on a loaded
-machine (``SequenceResult.hit_time_limit`` reports it).
+Two solvers: the default large-neighbourhood search (:mod:`planner.lns`) and
+OR-Tools routing with one mandatory disjunction per hole. Both are
+deterministic for a seed: they stop after an amount of work that depends on the
+problem size and the effort setting, not on the clock; the time budget is a
+hard cap that only binds on a slow or loaded machine
+(``SequenceResult.hit_time_limit`` reports it).
 """
 
 from __future__ import annotations
@@ -39,7 +40,8 @@ class SequenceResult:
 
     ``order[i]`` is the index (into the candidate list) of the i-th hole visited,
     ``choice[i]`` the row of that hole's candidate array used. ``cost_s`` is the sum
-    of rest-to-rest travel times home → holes → home (s).
+    of rest-to-rest travel times home → holes → home (s), with measured costs where
+    the sequencer learned them. ``nodes`` are the sequencer's node ids, if it has any.
     """
 
     order: list[int]
@@ -47,6 +49,7 @@ class SequenceResult:
     cost_s: float
     time_s: float
     hit_time_limit: bool
+    nodes: list[int] | None = None
 
 
 def tour_cost(
@@ -157,6 +160,93 @@ def solve_gtsp(
     return order, elapsed >= time_limit_s * 0.98
 
 
+class GtspSequencer:
+    """The GTSP of one cell: candidate nodes, their cost matrix, and repeated solves.
+
+    Node 0 is home; hole h owns ``groups[h]`` (at most ``nodes_per_hole`` of its
+    candidates, spread out in travel time). :meth:`learn` replaces estimated
+    costs by measured ones (e.g. a segment that needed a detour around an
+    obstacle) and :meth:`solve` can warm-start from a previous tour.
+    """
+
+    def __init__(
+        self,
+        home_q: NDArray[np.float64],
+        candidates: Sequence[NDArray[np.float64]],
+        limits: JointLimits,
+        nodes_per_hole: int = 16,
+        method: str = "lns",
+    ) -> None:
+        if method not in ("lns", "ortools"):
+            raise PlanningError(f"unknown sequencing method {method!r} (use 'lns' or 'ortools')")
+        if not candidates or any(len(c) == 0 for c in candidates):
+            raise PlanningError("the sequencer needs holes, each with a candidate configuration")
+        self.method = method
+        self.home = np.asarray(home_q, dtype=float)
+        self.candidates = [np.asarray(c, dtype=float) for c in candidates]
+        self.reps = [representatives(c, nodes_per_hole, self.home, limits) for c in self.candidates]
+        stacked = [c[r] for c, r in zip(self.candidates, self.reps, strict=True)]
+        self.nodes = np.vstack([self.home[None, :], *stacked])
+        self.owner = np.concatenate([[-1]] + [np.full(len(r), h) for h, r in enumerate(self.reps)])
+        self.local = np.concatenate([[-1]] + [np.asarray(r) for r in self.reps]).astype(np.int64)
+        offsets = np.cumsum([1] + [len(r) for r in self.reps])
+        self.groups = [np.arange(offsets[h], offsets[h] + len(r)) for h, r in enumerate(self.reps)]
+        table = CostTable(
+            limits.velocity, limits.acceleration, limits.jerk, limits.upper - limits.lower
+        )
+        self.G = table.matrix(self.nodes, self.nodes).astype(np.float64)
+        self.lim = (limits.velocity, limits.acceleration, limits.jerk)
+        self.learned: dict[tuple[int, int], float] = {}
+
+    def learn(self, costs: dict[tuple[int, int], float]) -> None:
+        """Set measured costs (s) for node pairs, both directions."""
+        for (u, v), c in costs.items():
+            self.G[u, v] = self.G[v, u] = c
+            self.learned[(u, v)] = self.learned[(v, u)] = c
+
+    def cost_of(self, visited: Sequence[int]) -> float:
+        """Cost (s) of visiting ``visited`` nodes in order from home back to home.
+
+        Exact rest-to-rest durations, except where a measured cost was learned.
+        """
+        path = [0, *visited, 0]
+        Q = self.nodes[path]
+        edges = travel_time(Q[:-1], Q[1:], *self.lim)
+        for k in range(len(path) - 1):
+            edges[k] = self.learned.get((path[k], path[k + 1]), edges[k])
+        return float(edges.sum())
+
+    def solve(
+        self,
+        time_budget_s: float,
+        seed: int,
+        effort: float = 1.0,
+        warm: Sequence[int] | None = None,
+    ) -> SequenceResult:
+        """Search a tour; ``warm`` (visited nodes) seeds the LNS instead of its greedy start."""
+        started = time.perf_counter()
+        n = len(self.candidates)
+        if self.method == "lns":
+            settings = LnsSettings(
+                max_iterations=int(effort * (300 + 8 * n)),
+                patience=int(effort * (60 + 2 * n)),
+                time_limit_s=time_budget_s,
+            )
+            start = None if warm is None else [int(self.owner[v]) for v in warm]
+            found = GtspLns(self.G, self.groups, seed).run(settings, start)
+            visited, hit = found.nodes, found.hit_time_limit
+        else:
+            limit = int(effort * (200 + 5 * n))
+            visited, hit = solve_gtsp(self.G, self.groups, time_budget_s, limit, seed)
+        if warm is not None and self.cost_of(warm) <= self.cost_of(visited):
+            visited = list(warm)
+        order = [int(self.owner[v]) for v in visited]
+        choice = [int(self.local[v]) for v in visited]
+        return SequenceResult(
+            order, choice, self.cost_of(visited), time.perf_counter() - started, hit, list(visited)
+        )
+
+
 def sequence(
     home_q: NDArray[np.float64],
     candidates: Sequence[NDArray[np.float64]],
@@ -166,54 +256,14 @@ def sequence(
     nodes_per_hole: int = 16,
     effort: float = 1.0,
     method: str = "lns",
-    final_nodes_per_hole: int = 16,
 ) -> SequenceResult:
-    """Order the holes and choose one configuration each (see module docstring).
+    """Order the holes and choose one configuration each, in one solve (see module docstring).
 
     ``candidates[h]`` holds hole h's collision-free configurations (k_h, dof), rad.
     ``method`` is ``"lns"`` (:mod:`planner.lns`, the default) or ``"ortools"``
     (routing with one disjunction per hole). ``effort`` scales the search work.
     """
-    started = time.perf_counter()
-    home_q = np.asarray(home_q, dtype=float)
-    if any(len(c) == 0 for c in candidates):
-        raise PlanningError("every hole handed to the sequencer needs a candidate configuration")
     if not candidates:
-        return SequenceResult([], [], 0.0, 0.0, False)
-    table = CostTable(
-        limits.velocity, limits.acceleration, limits.jerk, limits.upper - limits.lower
-    )
-    reps = [representatives(c, nodes_per_hole, home_q, limits) for c in candidates]
-    nodes = np.vstack([home_q[None, :]] + [c[r] for c, r in zip(candidates, reps, strict=True)])
-    owner = np.concatenate([[-1]] + [np.full(len(r), h) for h, r in enumerate(reps)]).astype(int)
-    offsets = np.cumsum([1] + [len(r) for r in reps])
-    groups = [np.arange(offsets[h], offsets[h] + len(r)) for h, r in enumerate(reps)]
-    G = table.matrix(nodes, nodes)
-    n = len(candidates)
-    if method == "lns":
-        settings = LnsSettings(
-            max_iterations=int(effort * (300 + 8 * n)),
-            patience=int(effort * (60 + 2 * n)),
-            time_limit_s=time_budget_s,
-        )
-        found = GtspLns(G, groups, seed).run(settings)
-        visited, hit = found.nodes, found.hit_time_limit
-    elif method == "ortools":
-        limit = int(effort * (200 + 5 * n))
-        visited, hit = solve_gtsp(G.astype(float), groups, time_budget_s, limit, seed)
-    else:
-        raise PlanningError(f"unknown sequencing method {method!r} (use 'lns' or 'ortools')")
-    order = [int(owner[v]) for v in visited]
-    # exact configuration choice for this order over (nearly) every candidate
-    rows = [representatives(candidates[h], final_nodes_per_hole, home_q, limits) for h in order]
-    layers = [candidates[h][r] for h, r in zip(order, rows, strict=True)]
-    picked, _ = layered_best(home_q, layers, limits)
-    choice = [int(r[c]) for r, c in zip(rows, picked, strict=True)]
-    cost = tour_cost(
-        home_q, np.array([candidates[h][c] for h, c in zip(order, choice, strict=True)]), limits
-    )
-    lns_choice = [int(reps[owner[v]][v - offsets[owner[v]]]) for v in visited]
-    lns_cost = tour_cost(home_q, nodes[visited], limits)
-    if lns_cost < cost:
-        choice, cost = lns_choice, lns_cost
-    return SequenceResult(order, choice, cost, time.perf_counter() - started, hit)
+        return SequenceResult([], [], 0.0, 0.0, False, [])
+    sequencer = GtspSequencer(home_q, candidates, limits, nodes_per_hole, method)
+    return sequencer.solve(time_budget_s, seed, effort)
