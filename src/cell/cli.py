@@ -13,7 +13,13 @@ import sys
 from collections.abc import Sequence
 
 #: subcommand modules under ``cell.commands``, in the order ``--help`` lists them
-COMMAND_MODULES: tuple[str, ...] = ("cell_show", "thermal_cmd", "plan_cmd", "measure_cmd")
+COMMAND_MODULES: tuple[str, ...] = (
+    "cell_show",
+    "thermal_cmd",
+    "plan_cmd",
+    "measure_cmd",
+    "calibrate_cmd",
+)
 
 
 def _user_error_types() -> tuple[type[BaseException], ...]:

@@ -1,0 +1,107 @@
+"""Calibration plate targets: geometry and detection (chessboard, asymmetric circle grid)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+TARGET_KINDS = ("chessboard", "circles")
+
+
+@dataclass(frozen=True)
+class TargetSpec:
+    """A plate target.
+
+    ``chessboard``: ``cols`` × ``rows`` inner corners, square side ``pitch_m``.
+    ``circles``: OpenCV's asymmetric grid, ``cols`` × ``rows`` circles; row ``i`` holds
+    circles at x = (2j + i mod 2)·pitch, y = i·pitch (metres).
+    """
+
+    kind: str
+    cols: int
+    rows: int
+    pitch_m: float
+    circle_diameter_frac: float = 0.7
+
+    def __post_init__(self) -> None:
+        if self.kind not in TARGET_KINDS:
+            raise ValueError(f"target kind must be one of {TARGET_KINDS}, got {self.kind!r}")
+        if self.cols < 3 or self.rows < 3 or not self.pitch_m > 0:
+            raise ValueError(f"bad target size {self.cols}x{self.rows}, pitch {self.pitch_m} m")
+
+    @property
+    def pattern_size(self) -> tuple[int, int]:
+        """``(cols, rows)`` as OpenCV's detectors take it."""
+        return (self.cols, self.rows)
+
+    def object_points(self) -> np.ndarray:
+        """Feature positions on the plate (N, 3, metres, z = 0), in detector order."""
+        s = self.pitch_m
+        if self.kind == "chessboard":
+            jj, ii = np.meshgrid(np.arange(self.cols), np.arange(self.rows))
+            pts = np.stack([jj.ravel() * s, ii.ravel() * s], axis=1)
+        else:
+            pts = np.array(
+                [[(2 * j + i % 2) * s, i * s] for i in range(self.rows) for j in range(self.cols)],
+                dtype=float,
+            )
+        return np.concatenate([pts, np.zeros((len(pts), 1))], axis=1)
+
+    def plate_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Plate corners (x, y) min and max (metres): the pattern plus a margin."""
+        p = self.object_points()[:, :2]
+        m = 1.5 * self.pitch_m
+        return p.min(axis=0) - m, p.max(axis=0) + m
+
+
+def detect_target(gray: np.ndarray, spec: TargetSpec) -> tuple[np.ndarray | None, str]:
+    """Find the target's features (N, 2, pixels) or say why not.
+
+    Returns ``(points, "")`` or ``(None, reason)`` where reason is "target not found",
+    "too few corners (k of n)" or "too blurred (edge width w px)".
+    """
+    img = (
+        gray
+        if gray.dtype == np.uint8
+        else cv2.normalize(gray, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
+    )
+    n = spec.cols * spec.rows
+    if spec.kind == "chessboard":
+        flags = (
+            cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_FAST_CHECK
+        )
+        found, pts = cv2.findChessboardCorners(img, spec.pattern_size, flags=flags)
+        if not found or pts is None:
+            return None, "target not found"
+        if len(pts) < n:
+            return None, f"too few corners ({len(pts)} of {n})"
+        crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4)
+        pts = cv2.cornerSubPix(img, pts, (5, 5), (-1, -1), crit)
+        width = float(cv2.estimateChessboardSharpness(img, spec.pattern_size, pts)[0][0])
+        if width > 4.0:
+            return None, f"too blurred (edge width {width:.1f} px)"
+        return pts.reshape(-1, 2).astype(np.float64), ""
+    found, pts = cv2.findCirclesGrid(img, spec.pattern_size, flags=cv2.CALIB_CB_ASYMMETRIC_GRID)
+    if not found or pts is None:
+        return None, "target not found"
+    if len(pts) < n:
+        return None, f"too few corners ({len(pts)} of {n})"
+    width = _edge_width(img, pts.reshape(-1, 2))
+    if width > 4.0:
+        return None, f"too blurred (edge width {width:.1f} px)"
+    return pts.reshape(-1, 2).astype(np.float64), ""
+
+
+def _edge_width(img: np.ndarray, pts: np.ndarray) -> float:
+    """Edge width (10–90 % rise, px) from the gradient over the target's bounding box."""
+    x0, y0 = np.floor(pts.min(axis=0)).astype(int)
+    x1, y1 = np.ceil(pts.max(axis=0)).astype(int)
+    roi = img[max(y0, 0) : y1 + 1, max(x0, 0) : x1 + 1].astype(np.float32)
+    if roi.size < 16:
+        return 0.0
+    g = cv2.magnitude(cv2.Sobel(roi, cv2.CV_32F, 1, 0), cv2.Sobel(roi, cv2.CV_32F, 0, 1)) / 8.0
+    contrast = float(np.percentile(roi, 95) - np.percentile(roi, 5))
+    peak = float(np.percentile(g, 99.5))
+    return 0.8 * contrast / max(peak, 1e-6)
