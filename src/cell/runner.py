@@ -24,8 +24,8 @@ from cell.inspect_hole import T_cell_tcp, inspect
 from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError, RequestRefusedError
-from cell.results import HoleResult
 from cell.reference import target_of
+from cell.results import HoleResult
 from cell.store import Store
 from cell.thermal_update import ThermalUpdate
 from measure import MeasurementError, head_frame, measure_hole
@@ -137,7 +137,7 @@ class Runner:
         result = RunResult("done")
         stored = self.store.stored_ids()
         try:
-            self._state("waiting")
+            self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
             if wait_for_start is not None:
                 wait_for_start()
             todo = [k for k, s in enumerate(self.tour.stops) if s.hole_id not in stored]
@@ -169,9 +169,9 @@ class Runner:
             result.link = vars(self.client.stats).copy()
         return result
 
-    def _state(self, state: str) -> None:
+    def _state(self, state: str, **extra: int) -> None:
         self.store.set_state(state)
-        self.progress("state", {"state": state})
+        self.progress("state", {"state": state, **extra})
         if self.recorder is not None:
             self.recorder.state(state)
 
@@ -237,7 +237,8 @@ class Runner:
                     self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
                     continue
                 p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
-                self.thermal.add(st.time_s, target_of(s.hole_id), st.q_rad, st.temperatures_c, p_tcp)
+                target = target_of(s.hole_id)
+                self.thermal.add(st.time_s, target, st.q_rad, st.temperatures_c, p_tcp)
                 self.progress("reference", {"round": rnd, "target": s.hole_id})
             self._move(len(tour.stops), "reference home")
             if rnd + 1 < self.options.reference_rounds:

@@ -1,9 +1,10 @@
 """The results store of a run: ``results.sqlite`` in the run directory (SQLite, WAL mode).
 
-Tables: ``meta`` (schema version), ``run`` (one row: cell name, SHA-256 and text of the cell file,
-the tour file's text, port, state, times), ``holes`` (every planned hole with its stop index and
-nominal geometry), ``measurements`` (at most one row per hole: a UNIQUE key makes storing a hole
-twice impossible), ``events`` (run state changes, faults, retries, thermal updates).
+Tables: ``meta`` (schema version), ``run`` (one row: cell name, SHA-256, text and path of the
+cell file, the tour's and the reference tour's text, port, state, times), ``holes`` (every
+planned hole with its stop index and nominal geometry), ``measurements`` (at most one row per
+hole: a UNIQUE key makes storing a hole twice impossible), ``events`` (run state changes,
+faults, retries, thermal updates).
 
 Each hole is stored in one transaction, so a killed process leaves every hole either fully
 stored or not at all. Opening checks the schema and the file's integrity first and refuses a
@@ -29,7 +30,8 @@ CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE run (
     id INTEGER PRIMARY KEY CHECK (id = 1),
     cell_name TEXT NOT NULL, cell_sha256 TEXT NOT NULL, cell_text TEXT NOT NULL,
-    tour_text TEXT NOT NULL, robot_model TEXT NOT NULL, port TEXT NOT NULL,
+    cell_path TEXT NOT NULL, tour_text TEXT NOT NULL, reference_text TEXT NOT NULL,
+    robot_model TEXT NOT NULL, port TEXT NOT NULL,
     state TEXT NOT NULL, started_at REAL NOT NULL, finished_at REAL
 );
 CREATE TABLE holes (
@@ -72,7 +74,9 @@ class Store:
         cell_name: str,
         cell_sha256: str,
         cell_text: str,
+        cell_path: str,
         tour_text: str,
+        reference_text: str,
         robot_model: str,
         port: str,
         holes: list[tuple[str, int, dict[str, Any]]],
@@ -87,8 +91,18 @@ class Store:
             con.executescript(_SCHEMA)
             con.execute("INSERT INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
             con.execute(
-                "INSERT INTO run VALUES (1, ?, ?, ?, ?, ?, ?, 'created', ?, NULL)",
-                (cell_name, cell_sha256, cell_text, tour_text, robot_model, port, time.time()),
+                "INSERT INTO run VALUES (1, ?, ?, ?, ?, ?, ?, ?, ?, 'created', ?, NULL)",
+                (
+                    cell_name,
+                    cell_sha256,
+                    cell_text,
+                    cell_path,
+                    tour_text,
+                    reference_text,
+                    robot_model,
+                    port,
+                    time.time(),
+                ),
             )
             con.executemany(
                 "INSERT INTO holes VALUES (?, ?, ?)",

@@ -1,0 +1,99 @@
+"""``holecell demo [--out DIR]``: the whole job on the built-in cell, simulated cell and head."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from cell.commands.run_progress import RunBars, bar
+from cell.demo import DemoOptions, DemoResult, run_demo
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``demo``."""
+    p = sub.add_parser(
+        "demo",
+        help="plan and run the built-in motorcycle frame on the simulated cell",
+        description=(
+            "Plans the tour of the built-in motorcycle frame, runs it on the simulated "
+            "controller over a pseudo-terminal with a warming arm (reference targets measured "
+            "during the warm-up, thermal model identified), measures every hole with the "
+            "simulated stereo head, and writes DIR/results.sqlite, report.json, report.csv "
+            "and run.rrd. Prints a summary with the measurement error against the simulation's "
+            "truth."
+        ),
+    )
+    p.add_argument("--out", default=None, help="run directory (default: out/demo-<time>)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the simulated part and noise")
+    p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+    p.set_defaults(handler=run_demo_cmd)
+
+
+def _plan_bars(quiet: bool):
+    if quiet:
+        return None
+    from cell.commands.plan_cmd import StageBars
+
+    return StageBars()
+
+
+def _recorder_factory(enabled: bool):
+    if not enabled:
+        return None
+    from cell.record import Recorder
+
+    return lambda run_dir, cell, tour: Recorder.create(run_dir / "run.rrd", cell, tour)
+
+
+def format_demo(res: DemoResult) -> str:
+    """The summary table (mm and um for people)."""
+    s, t, tr = res.summary, res.timings, res.truth
+    measured, planned = s["holes_measured"], s["holes_planned"]
+    worst = s["worst_position_deviation_m"]
+    rows = [
+        ("holes measured", f"{bar(measured, planned, 20)} {measured}/{planned}"),
+        ("missing / out of tol.", f"{s['holes_missing']} / {s['holes_failed']}"),
+        ("worst deviation", f"{worst * 1e3:.4f} mm (hole {s['worst_hole']})" if worst else "-"),
+        ("cycle time (planned)", f"{res.tour.cycle_time_s:.1f} s"),
+        ("error vs truth, RMS", f"{tr.rms_m * 1e6:.1f} um (max {tr.max_m * 1e6:.1f} um)"),
+        ("  without thermal comp.", f"{tr.rms_uncompensated_m * 1e6:.1f} um RMS"),
+        ("diameter error, RMS", f"{tr.diameter_rms_m * 1e6:.1f} um"),
+        ("thermal update", res.run.thermal or "-"),
+        ("link", f"{res.run.link.get('requests', 0)} requests, "
+                 f"{res.run.link.get('retransmits', 0)} retransmitted"),
+        ("wall time", f"{t['total_s']:.1f} s (plan {t['plan_s']:.1f} s, run {t['run_s']:.1f} s)"),
+        ("run directory", str(res.run_dir)),
+    ]  # fmt: skip
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
+
+
+def run_demo_cmd(args: argparse.Namespace) -> int:
+    """Handler of ``holecell demo``."""
+    out = Path(args.out) if args.out else Path("out") / time.strftime("demo-%Y%m%d-%H%M%S")
+    bars = None if args.quiet else RunBars(0)
+    res = run_demo(
+        out,
+        DemoOptions(seed=args.seed, record=not args.no_record),
+        _plan_bars(args.quiet),
+        _progress(bars),
+        _recorder_factory(not args.no_record),
+    )
+    print(format_demo(res))
+    if not args.no_record:
+        print(f"open the recording:  rerun {out / 'run.rrd'}")
+    return 0
+
+
+def _progress(bars: RunBars | None):
+    if bars is None:
+        return None
+
+    def progress(event: str, data: dict) -> None:
+        if event == "state" and data["state"] == "waiting":
+            bars.total, bars.done = data["holes"], data["stored"]
+        bars(event, data)
+
+    return progress

@@ -1,0 +1,30 @@
+"""``holecell report RUN_DIR``: write report.json and report.csv of a run and print a summary."""
+
+from __future__ import annotations
+
+import argparse
+
+from cell.report import format_summary, write_report
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``report``."""
+    p = sub.add_parser(
+        "report",
+        help="write report.json / report.csv of a run and print its summary",
+        description=(
+            "Reads RUN_DIR/results.sqlite (never modifies it) and writes RUN_DIR/report.json "
+            "(summary, every hole, every event; SI units) and RUN_DIR/report.csv (one row per "
+            "hole: nominal and measured centre, deviation, diameter, pass, uncertainty)."
+        ),
+    )
+    p.add_argument("run_dir", help="a run directory (holds results.sqlite)")
+    p.set_defaults(handler=run_report)
+
+
+def run_report(args: argparse.Namespace) -> int:
+    """Handler of ``holecell report``."""
+    summ = write_report(args.run_dir)
+    print(format_summary(summ))
+    print(f"wrote {args.run_dir}/report.json and {args.run_dir}/report.csv")
+    return 0

@@ -1,0 +1,106 @@
+"""``holecell run``: run a tour on the cell controller, measure every hole, store and report."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from cell.camera import NetworkCamera
+from cell.commands.run_progress import RunBars
+from cell.config import load_cell
+from cell.errors import CellError
+from cell.link.client import ControllerClient
+from cell.reference import plan_reference_tour
+from cell.report import format_summary, write_report
+from cell.run_setup import RunFiles, resume_run, start_run
+from cell.runner import Runner, RunOptions
+from cell.sim.session import cell_stereo
+from planner import load_tour
+from robots.thermal.modelfile import load_model
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``run``."""
+    p = sub.add_parser(
+        "run",
+        help="run a tour on the controller and measure every hole",
+        description=(
+            "Reads TOUR (tour.json from holecell plan) and CELL (the cell file it was planned "
+            "for; refused otherwise), connects to the controller at --port (/dev/ttyS0, "
+            "socket://host:port or a pty path) and the stereo head at --camera, measures the "
+            "reference targets and updates the thermal compensation, then measures every hole. "
+            "Writes RUN_DIR/results.sqlite (every hole in its own transaction), report.json "
+            "and report.csv. --resume RUN_DIR continues a stopped run from the first hole not "
+            "stored, with the cell and tour stored in it."
+        ),
+    )
+    p.add_argument("tour", nargs="?", help="tour.json (not with --resume)")
+    p.add_argument("--cell", help="cell file the tour was planned for")
+    p.add_argument("--port", required=True, help="controller port URL")
+    p.add_argument("--camera", required=True, help="stereo head: tcp://HOST:PORT")
+    p.add_argument("--out", default=None, help="run directory to create (default: runs/<tour>)")
+    p.add_argument("--resume", metavar="RUN_DIR", help="continue the run stored in RUN_DIR")
+    p.add_argument("--thermal", help="thermal.json model to start from (holecell thermal)")
+    p.add_argument("--reference-rounds", type=int, default=1, help="rounds over the targets")
+    p.add_argument("--reference-interval-s", type=float, default=300.0,
+                   help="controller seconds between reference rounds")  # fmt: skip
+    p.add_argument("--settle-s", type=float, default=0.2, help="settling wait (s)")
+    p.add_argument("--yes", action="store_true", help="start without asking")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+    p.set_defaults(handler=run_run)
+
+
+def _files(args: argparse.Namespace) -> RunFiles:
+    if args.resume:
+        if args.tour or args.cell:
+            raise CellError("--resume takes the cell and tour from the run; give neither")
+        return resume_run(args.resume)
+    if not args.tour or not args.cell:
+        raise CellError("give TOUR and --cell CELL (or --resume RUN_DIR)")
+    cell = load_cell(args.cell)
+    tour = load_tour(args.tour)
+    reference = (
+        plan_reference_tour(cell) if cell.reference_targets and args.reference_rounds else None
+    )
+    out = Path(args.out) if args.out else Path("runs") / Path(args.tour).stem
+    return start_run(out, cell, tour, args.tour, args.port, reference)
+
+
+def _ask_start() -> None:
+    input("press Enter to start the run (Ctrl-C to cancel) ")
+
+
+def run_run(args: argparse.Namespace) -> int:
+    """Handler of ``holecell run``."""
+    files = _files(args)
+    run_dir = files.store.path.parent
+    model = load_model(args.thermal) if args.thermal else None
+    stored = len(files.store.stored_ids())
+    client = ControllerClient(args.port)
+    camera = None
+    try:
+        client.connect()
+        if client.identity.robot_model != files.cell.robot.model:
+            raise CellError(
+                f"controller at {args.port} drives {client.identity.robot_model!r}, "
+                f"the cell has {files.cell.robot.model!r}"
+            )
+        camera = NetworkCamera(args.camera, cell_stereo(files.cell))
+        options = RunOptions(
+            settle_s=args.settle_s,
+            reference_rounds=args.reference_rounds,
+            reference_interval_s=args.reference_interval_s,
+        )
+        progress = None if args.quiet else RunBars(len(files.tour.stops), stored)
+        runner = Runner(files.cell, files.tour, files.store, client, camera, options,
+                        files.reference, model, progress)  # fmt: skip
+        runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
+    finally:
+        client.close()
+        if camera is not None:
+            camera.close()
+        files.store.close()
+    print(format_summary(write_report(run_dir)))
+    print(f"run directory: {run_dir}")
+    return 0

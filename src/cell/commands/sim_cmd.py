@@ -1,0 +1,70 @@
+"""``holecell sim [CELL]``: the simulated controller and stereo head, stand-alone.
+
+For testing a cell computer (``holecell run``) against a simulated cell: prints the controller
+port (a pty path or ``socket://127.0.0.1:PORT``) and the camera URL (``tcp://127.0.0.1:PORT``),
+then serves until interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from cell.config import load_cell
+from cell.sim.camserver import CameraServer
+from cell.sim.faults import FaultPlan
+from cell.sim.session import SimCell
+from cell.sim.world import WorldOptions
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``sim``."""
+    p = sub.add_parser(
+        "sim",
+        help="serve a simulated controller and stereo head for holecell run",
+        description=(
+            "Reads CELL (default: the built-in motorcycle frame) and serves the simulated "
+            "controller (protocol of docs/protocol.md) on a pseudo-terminal or a local socket, "
+            "and the simulated stereo head on a local TCP port. Prints both URLs; writes nothing."
+        ),
+    )
+    p.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
+    p.add_argument("--transport", choices=("pty", "socket"), default="pty")
+    p.add_argument("--speed", type=float, default=1.0, help="simulation speed (x real time)")
+    p.add_argument("--drift-offset-s", type=float, default=0.0, help="warm-up already elapsed")
+    p.add_argument("--drop", type=float, default=0.0, help="probability a frame is lost")
+    p.add_argument("--corrupt", type=float, default=0.0, help="probability of a flipped bit")
+    p.add_argument("--delay", type=float, default=0.0, help="probability an answer is late")
+    p.add_argument("--disconnect-after", type=int, default=None, help="requests, then cut")
+    p.add_argument("--estop-at", type=int, default=None, help="e-stop on arrival at stop K")
+    p.add_argument("--missing", nargs="*", default=(), help="hole ids that are not there")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--duration-s", type=float, default=None, help="stop after this long")
+    p.set_defaults(handler=run_sim)
+
+
+def run_sim(args: argparse.Namespace) -> int:
+    """Handler of ``holecell sim``."""
+    cell = load_cell(args.cell)
+    faults = FaultPlan(
+        drop=args.drop,
+        corrupt=args.corrupt,
+        delay=args.delay,
+        disconnect_after=args.disconnect_after,
+        estop_at_stop=args.estop_at,
+        missing_holes=tuple(args.missing),
+        seed=args.seed,
+    )
+    world = WorldOptions(speed=args.speed, drift_offset_s=args.drift_offset_s, seed=args.seed)
+    with SimCell.start(cell, world, faults, args.transport) as sim:
+        cam = CameraServer(sim.camera).start()
+        try:
+            print(f"controller  {sim.url}", flush=True)
+            print(f"camera      {cam.url}", flush=True)
+            print("serving; Ctrl-C to stop", flush=True)
+            t_end = None if args.duration_s is None else time.monotonic() + args.duration_s
+            while t_end is None or time.monotonic() < t_end:
+                time.sleep(0.2)
+        finally:
+            cam.close()
+    return 0

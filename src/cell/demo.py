@@ -1,0 +1,147 @@
+"""The whole job on the built-in cell with the simulated controller and cameras.
+
+Plan the tour of the built-in motorcycle frame (and the reference-target tour), start the
+simulated cell on a pseudo-terminal with a cold arm, let the runner measure the reference targets
+while the arm warms up (the simulation fast-forwards the warm-up at ``warmup_speed``), identify
+the thermal model, then measure every hole at ``run_speed``. Since the simulation knows the
+truth, the result also holds the measurement error against it, with and without compensation.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cell.config import load_builtin_cell
+from cell.link.client import ControllerClient
+from cell.reference import plan_reference_tour
+from cell.report import write_report
+from cell.results import HoleResult
+from cell.run_setup import start_run
+from cell.runner import Progress, Runner, RunOptions, RunResult
+from cell.sim.faults import FaultPlan
+from cell.sim.session import SimCell
+from cell.sim.world import SimWorld, WorldOptions
+from planner import Options, Tour, TourPlanner
+from robots.transforms import invert
+
+
+@dataclass(frozen=True)
+class DemoOptions:
+    """Settings of the demo.
+
+    Attributes:
+        warmup_speed: simulation speed while the reference targets are measured (x real time).
+        run_speed: simulation speed while the holes are measured.
+        reference_rounds: rounds over the reference targets during the warm-up.
+        reference_interval_s: simulated seconds between two rounds.
+        faults: what the simulated controller does wrong (none by default).
+        seed: seed of the part's true geometry, sensor noise and image noise.
+        record: write ``run.rrd``.
+    """
+
+    warmup_speed: float = 600.0
+    run_speed: float = 10.0
+    reference_rounds: int = 4
+    reference_interval_s: float = 900.0
+    faults: FaultPlan = field(default_factory=FaultPlan)
+    seed: int = 0
+    record: bool = True
+
+
+@dataclass
+class TruthError:
+    """Measured minus true hole centres (m, part frame) over the measured holes."""
+
+    rms_m: float
+    max_m: float
+    rms_uncompensated_m: float
+    diameter_rms_m: float
+    n: int
+
+
+@dataclass
+class DemoResult:
+    """Outcome of :func:`run_demo`."""
+
+    run_dir: Path
+    tour: Tour
+    run: RunResult
+    summary: dict[str, Any]
+    truth: TruthError
+    timings: dict[str, float]
+
+
+def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
+    """Measurement error against the simulation's true holes."""
+    T_part_cell = invert(world.cell.T_cell_part())
+    e, e_u, e_d = [], [], []
+    for r in results:
+        if r.center_part_m is None:
+            continue
+        h = world.holes[r.hole_id]
+        true_c = T_part_cell[:3, :3] @ h.position_m + T_part_cell[:3, 3]
+        e.append(np.linalg.norm(np.array(r.center_part_m) - true_c))
+        e_u.append(np.linalg.norm(np.array(r.extra["center_part_uncompensated_m"]) - true_c))
+        e_d.append(r.diameter_m - h.diameter_m)
+
+    def rms(v: list[float]) -> float:
+        return float(np.sqrt(np.mean(np.square(v)))) if v else float("nan")
+
+    return TruthError(rms(e), float(max(e, default=float("nan"))), rms(e_u), rms(e_d), len(e))
+
+
+def run_demo(
+    out_dir: str | Path,
+    options: DemoOptions | None = None,
+    plan_progress: Callable[[str, int, int], None] | None = None,
+    run_progress: Progress | None = None,
+    recorder_factory: Callable[..., Any] | None = None,
+) -> DemoResult:
+    """Plan, run and report the built-in cell in ``out_dir`` (created; must not hold a run)."""
+    opts = options or DemoOptions()
+    t0 = time.perf_counter()
+    cell = load_builtin_cell()
+    tour = TourPlanner(Options(seed=opts.seed), plan_progress).plan(cell)
+    reference = plan_reference_tour(cell, Options(seed=opts.seed))
+    t_plan = time.perf_counter() - t0
+    world = WorldOptions(speed=opts.warmup_speed, drift_offset_s=0.0, seed=opts.seed)
+    with SimCell.start(cell, world, opts.faults) as sim:
+        files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
+
+        def progress(event: str, data: dict) -> None:
+            if event == "state" and data["state"] == "inspecting":
+                sim.world.clock.set_speed(opts.run_speed)
+            if run_progress is not None:
+                run_progress(event, data)
+
+        run_opts = RunOptions(
+            settle_s=0.2 / opts.run_speed,
+            reference_rounds=opts.reference_rounds,
+            reference_interval_s=opts.reference_interval_s,
+        )
+        client = ControllerClient(sim.url)
+        recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
+        try:
+            client.connect()
+            runner = Runner(cell, tour, files.store, client, sim.camera, run_opts, reference,
+                            None, progress, recorder)  # fmt: skip
+            result = runner.run()
+            truth = truth_error(sim.world, files.store.results())
+        finally:
+            client.close()
+            files.store.close()
+            if recorder is not None:
+                recorder.close()
+    summary = write_report(out_dir)
+    timings = {
+        "plan_s": t_plan,
+        "run_s": result.timings["run_s"],
+        "total_s": time.perf_counter() - t0,
+    }
+    return DemoResult(Path(out_dir), tour, result, summary, truth, timings)

@@ -1,0 +1,240 @@
+"""Rerun recording of a run: ``run.rrd`` in the run directory, optionally a live viewer too.
+
+What is logged (entity paths; 3D in the robot base frame, which is the cell frame when the base
+sits at the cell origin, m):
+
+- ``robot``: the arm from its URDF (static); joint transforms on ``transforms`` at every stop
+  (timeline ``run_time``, the controller clock in s) and along the planned trajectory
+  (timeline ``tour_time``, s, every 0.1 s).
+- ``cell/obstacles/*``: part and environment obstacles; ``cell/holes``: nominal holes and normals.
+- ``tour/path``: planned TCP path; ``tour/stops``: the stops.
+- ``run/tcp``: TCP position at each stop; ``run/hole/points``: triangulated edge points;
+  ``run/hole/circle``: the fitted circle; ``camera/left|right``: the image region of each pair
+  with its edge points (filled ones in orange) and fitted ellipse drawn over it.
+- ``plots/deviation/*`` (um), ``plots/temperature/*`` (degC): time series; ``run/state``: the
+  run state as a state timeline.
+
+An explicit default blueprint lays it out (3D view, the two cameras, plots, state timeline).
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from cell.config import CellConfig
+from cell.results import HoleResult
+from planner import Tour
+from robots import Shape
+from robots.transforms import invert
+
+log = logging.getLogger(__name__)
+
+#: pixels of margin around the measured region of interest in the logged image crops
+CROP_MARGIN_PX = 20
+
+
+def blueprint() -> rrb.Blueprint:
+    """The default layout of a run recording."""
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Spatial3DView(
+                name="cell",
+                origin="/",
+                contents=["/robot/**", "/cell/**", "/tour/**", "/run/**", "/transforms/**"],
+            ),
+            rrb.Vertical(
+                rrb.Horizontal(
+                    rrb.Spatial2DView(name="left camera", origin="/camera/left"),
+                    rrb.Spatial2DView(name="right camera", origin="/camera/right"),
+                ),
+                rrb.TimeSeriesView(name="deviation (um)", origin="/plots/deviation"),
+                rrb.TimeSeriesView(name="temperatures (degC)", origin="/plots/temperature"),
+                rrb.StateTimelineView(name="run state", origin="/run/state"),
+            ),
+            column_shares=[3, 2],
+        ),
+        collapse_panels=True,
+    )
+
+
+class Recorder:
+    """Logs one run. ``create`` opens the file (and a viewer with ``spawn``/``connect``)."""
+
+    def __init__(self, rec: rr.RecordingStream, cell: CellConfig, tour: Tour) -> None:
+        self.rec = rec
+        self.cell = cell
+        self.tour = tour
+        self.arm = cell.build_arm()
+        self.T_base_cell = invert(cell.T_cell_base())
+        self.urdf = rr.urdf.UrdfTree.from_file_path(self.arm.urdf_path)
+        self.joints = {j.name: j for j in self.urdf.joints()}
+
+    @classmethod
+    def create(
+        cls,
+        path: str | Path,
+        cell: CellConfig,
+        tour: Tour,
+        spawn: bool = False,
+        connect: str | None = None,
+    ) -> Recorder:
+        """Record to ``path``; also to a spawned viewer or the one at ``connect`` (gRPC URL)."""
+        rec = rr.RecordingStream("holecell", recording_id=None)
+        sinks: list = [rr.FileSink(str(path))]
+        if spawn:
+            rec.spawn(connect=False)
+            sinks.append(rr.GrpcSink())
+        elif connect:
+            sinks.append(rr.GrpcSink(connect))
+        rec.set_sinks(*sinks, default_blueprint=blueprint())
+        self = cls(rec, cell, tour)
+        self._static()
+        return self
+
+    def close(self) -> None:
+        """Flush and close the recording."""
+        self.rec.flush()
+        self.rec.disconnect()
+
+    # --- static scene -----------------------------------------------------------------------
+    def _p(self, p_cell: np.ndarray) -> np.ndarray:
+        p = np.asarray(p_cell, float).reshape(-1, 3)
+        return p @ self.T_base_cell[:3, :3].T + self.T_base_cell[:3, 3]
+
+    def _static(self) -> None:
+        rec = self.rec
+        rec.log_file_from_path(self.arm.urdf_path, static=True)
+        for i, shape in enumerate(self.cell.obstacle_shapes()):
+            self._shape(f"cell/obstacles/{i}_{shape.name}", shape)
+        holes = self.cell.holes_in_cell()
+        pos = self._p(np.array([h.position_m for h in holes]))
+        nrm = np.array([h.normal for h in holes]) @ self.T_base_cell[:3, :3].T
+        rec.log(
+            "cell/holes",
+            rr.Points3D(pos, radii=0.003, labels=[h.id for h in holes], colors=[80, 160, 255]),
+            static=True,
+        )
+        rec.log("cell/holes/normals", rr.Arrows3D(origins=pos, vectors=0.03 * nrm), static=True)
+        traj = self.tour.trajectory[:: max(1, round(0.02 / self.tour.dt))]
+        tcp = self._p(np.array([self.arm.fk(q, "tcp")[:3, 3] for q in traj]))
+        rec.log("tour/path", rr.LineStrips3D([tcp], radii=0.001, colors=[255, 200, 0]), static=True)
+        stops = self._p(
+            np.array([self.arm.fk(np.array(s.q), "tcp")[:3, 3] for s in self.tour.stops])
+        )
+        rec.log(
+            "tour/stops",
+            rr.Points3D(stops, radii=0.004, colors=[255, 120, 0], labels=self.tour.hole_order),
+            static=True,
+        )
+        step = max(1, round(0.1 / self.tour.dt))
+        for i in range(0, len(self.tour.trajectory), step):
+            rec.set_time("tour_time", duration=i * self.tour.dt)
+            self._joints(self.tour.trajectory[i])
+
+    def _shape(self, path: str, s: Shape) -> None:
+        T = self.T_base_cell @ np.asarray(s.T, float)
+        quat = rr.Quaternion(xyzw=_quat_xyzw(T[:3, :3]))
+        kind = s.kind
+        if kind == "box":
+            arch = rr.Boxes3D(
+                half_sizes=[np.asarray(s.size) / 2],
+                centers=[T[:3, 3]],
+                quaternions=[quat],
+                colors=[150, 150, 150],
+            )
+        elif kind in ("cylinder", "capsule"):
+            arch = rr.Cylinders3D(
+                lengths=[s.size[1]],
+                radii=[s.size[0]],
+                centers=[T[:3, 3]],
+                quaternions=[quat],
+                colors=[150, 150, 150],
+            )
+        else:
+            arch = rr.Ellipsoids3D(
+                half_sizes=[[s.size[0]] * 3], centers=[T[:3, 3]], colors=[150, 150, 150]
+            )
+        self.rec.log(path, arch, static=True)
+
+    def _joints(self, q: np.ndarray) -> None:
+        for name, value in zip(self.arm.joint_names, q, strict=True):
+            self.rec.log(
+                "transforms", self.joints[name].compute_transform(float(value), clamp=False)
+            )
+
+    # --- during the run ---------------------------------------------------------------------
+    def state(self, state: str) -> None:
+        """The run state changed."""
+        self.rec.log("run/state", rr.StateChange(state=state))
+
+    def hole(self, result: HoleResult, meas, pair, status, T_cell_left: np.ndarray) -> None:
+        """Log one stop: joints, temperatures, images with edges and ellipse, 3D points,
+        circle, deviations."""
+        rec = self.rec
+        rec.set_time("run_time", duration=float(status.time_s))
+        self._joints(status.q_rad)
+        tcp = self._p(self.arm.fk(status.q_rad, "tcp")[:3, 3])
+        rec.log("run/tcp", rr.Points3D(tcp, radii=0.005, colors=[0, 220, 0]))
+        for i, t in enumerate(status.temperatures_c):
+            rec.log(f"plots/temperature/s{i + 1}", rr.Scalars(float(t)))
+        if meas is None:
+            rec.log("run/event", rr.TextLog(f"{result.hole_id}: {result.reason}", level="WARN"))
+            return
+        rec.log("plots/deviation/position", rr.Scalars(result.position_deviation_m * 1e6))
+        rec.log("plots/deviation/diameter", rr.Scalars(result.diameter_deviation_m * 1e6))
+        self._images(meas, pair)
+        T = self.T_base_cell @ T_cell_left
+        pts = meas.points_m[meas.inliers] @ T[:3, :3].T + T[:3, 3]
+        rec.log("run/hole/points", rr.Points3D(pts, radii=0.0002, colors=[0, 200, 255]))
+        rec.log(
+            "run/hole/circle",
+            rr.LineStrips3D([_circle(meas, T)], radii=0.0003, colors=[255, 0, 80]),
+        )
+
+    def _images(self, meas, pair) -> None:
+        m = meas
+        sides = (
+            ("left", pair.left, m.roi_left, m.edges_left_px, m.filled_left, m.ellipse_left),
+            ("right", pair.right, m.roi_right, m.edges_right_px, m.filled_right, m.ellipse_right),
+        )
+        for side, img, roi, edges, filled, ellipse in sides:
+            x, y, w, h = roi
+            x0, y0 = max(0, x - CROP_MARGIN_PX), max(0, y - CROP_MARGIN_PX)
+            x1 = min(img.shape[1], x + w + CROP_MARGIN_PX)
+            y1 = min(img.shape[0], y + h + CROP_MARGIN_PX)
+            off = np.array([x0, y0], float)
+            self.rec.log(f"camera/{side}/image", rr.Image(np.ascontiguousarray(img[y0:y1, x0:x1])))
+            e = np.asarray(edges, float) - off
+            colors = np.where(np.asarray(filled, bool)[:, None], [255, 140, 0], [0, 255, 0])
+            self.rec.log(f"camera/{side}/edges", rr.Points2D(e, radii=0.6, colors=colors))
+            strip = rr.LineStrips2D([_ellipse(ellipse) - off], colors=[255, 0, 80])
+            self.rec.log(f"camera/{side}/ellipse", strip)
+
+
+def _ellipse(e, n: int = 120) -> np.ndarray:
+    (cx, cy), (a1, a2), ang = e
+    t = np.linspace(0, 2 * np.pi, n)
+    c, s = np.cos(np.radians(ang)), np.sin(np.radians(ang))
+    x, y = 0.5 * a1 * np.cos(t), 0.5 * a2 * np.sin(t)
+    return np.stack([cx + c * x - s * y, cy + s * x + c * y], axis=1)
+
+
+def _circle(meas, T: np.ndarray, n: int = 120) -> np.ndarray:
+    nrm = np.asarray(meas.normal, float)
+    u = np.cross(nrm, [1.0, 0.0, 0.0] if abs(nrm[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(nrm, u)
+    t = np.linspace(0, 2 * np.pi, n)[:, None]
+    pts = meas.center_m + meas.radius_m * (np.cos(t) * u + np.sin(t) * v)
+    return pts @ T[:3, :3].T + T[:3, 3]
+
+
+def _quat_xyzw(R: np.ndarray) -> list[float]:
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_matrix(R).as_quat().tolist()

@@ -1,0 +1,117 @@
+"""Starting and resuming runs from files, refusing inputs that do not belong together.
+
+A tour is refused when it was planned for another cell (name or SHA-256 of the cell file text),
+another robot model or other joint names, when its trajectory is not (N, 6), or when a stop is
+not on the trajectory or names a hole the cell does not have. A resumed run reads the cell and
+both tours from its own store, so it continues exactly what was started.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from cell.config import CellConfig, parse_cell
+from cell.errors import CellError
+from cell.runner import stop_rows
+from cell.store import Store
+from planner import Tour
+from planner.planner import cell_sha256
+from planner.tour import tour_from_dict
+from robots.models import JOINT_NAMES
+
+
+class TourMismatchError(CellError):
+    """A tour does not belong to the cell (or robot) it is run with."""
+
+    def __init__(self, tour: str, field: str, tour_value: object, cell_value: object) -> None:
+        self.tour, self.field = tour, field
+        super().__init__(
+            f"{tour}: {field} is {tour_value!r} but the cell has {cell_value!r}: "
+            "plan the tour for this cell (holecell plan CELL -o tour.json)"
+        )
+
+
+def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False) -> None:
+    """Refuse a tour not made for ``cell``. Reference tours are checked for the robot only."""
+    if not reference:
+        if tour.cell_name != cell.name:
+            raise TourMismatchError(where, "cell.name", tour.cell_name, cell.name)
+        if tour.cell_sha256 != cell_sha256(cell):
+            raise TourMismatchError(
+                where, "cell.sha256", tour.cell_sha256[:12], cell_sha256(cell)[:12]
+            )
+    if tour.robot_model != cell.robot.model:
+        raise TourMismatchError(where, "robot.model", tour.robot_model, cell.robot.model)
+    if tuple(tour.joint_names) != JOINT_NAMES:
+        raise TourMismatchError(where, "robot.joint_names", tour.joint_names, JOINT_NAMES)
+    traj = np.asarray(tour.trajectory)
+    if traj.ndim != 2 or traj.shape[1] != 6 or len(traj) < 2:
+        raise CellError(f"{where}: trajectory has shape {traj.shape}, expected (N >= 2, 6)")
+    if not reference:
+        known = {h.id for h in cell.part.holes}
+        unknown = [s.hole_id for s in tour.stops if s.hole_id not in known]
+        if unknown:
+            raise TourMismatchError(where, "stops.hole_id", unknown[:5], "no such holes")
+    stop_rows(tour)
+
+
+@dataclass
+class RunFiles:
+    """What a run needs from files: the cell, the tours and the store."""
+
+    cell: CellConfig
+    tour: Tour
+    reference: Tour | None
+    store: Store
+
+
+def start_run(
+    run_dir: str | Path,
+    cell: CellConfig,
+    tour: Tour,
+    tour_where: str,
+    port: str,
+    reference: Tour | None = None,
+) -> RunFiles:
+    """Check the inputs, then create the store of a new run in ``run_dir``."""
+    check_tour(tour, cell, tour_where)
+    if reference is not None:
+        check_tour(reference, cell, "reference tour", reference=True)
+    holes = {h.id: h for h in cell.part.holes}
+    planned = [
+        (s.hole_id, k, {"position_part_m": list(holes[s.hole_id].position),
+                        "diameter_m": holes[s.hole_id].diameter})
+        for k, s in enumerate(tour.stops)
+    ]  # fmt: skip
+    store = Store.create(
+        run_dir,
+        cell_name=cell.name,
+        cell_sha256=cell_sha256(cell),
+        cell_text=cell.raw_text,
+        cell_path=str(cell.source_path or ""),
+        tour_text=json.dumps(tour.to_dict()),
+        reference_text=json.dumps(reference.to_dict()) if reference is not None else "",
+        robot_model=cell.robot.model,
+        port=port,
+        holes=planned,
+    )
+    return RunFiles(cell, tour, reference, store)
+
+
+def resume_run(run_dir: str | Path) -> RunFiles:
+    """Reopen ``run_dir``: the cell and tours come from its store, checked again."""
+    store = Store.open(run_dir)
+    info = store.run_info()
+    where = f"{store.path}"
+    path = Path(info["cell_path"]) if info["cell_path"] else None
+    cell = parse_cell(info["cell_text"], f"{where} (cell)", path)
+    tour = tour_from_dict(json.loads(info["tour_text"]), f"{where} (tour)")
+    reference = None
+    if info["reference_text"]:
+        reference = tour_from_dict(json.loads(info["reference_text"]), f"{where} (reference)")
+    check_tour(tour, cell, f"{where} (tour)")
+    return RunFiles(cell, tour, reference, store)
