@@ -18,7 +18,7 @@ import numpy as np
 from measure.calibration import StereoCalibration
 from measure.synth.hole_scene import HoleGeometry, Shading, shade
 from measure.synth.optics import ray_grid, vignetting
-from measure.synth.texture import TEXEL_M, background_noise, sample_texture
+from measure.synth.texture import TEXEL_M, TILE_CENTER_M, background_noise, sample_texture
 
 
 @dataclass(frozen=True)
@@ -193,23 +193,28 @@ def _render_window(
 def _finish(img: np.ndarray, opts: RenderOptions, win, rng: np.random.Generator) -> np.ndarray:
     """Scale to gray levels, add shot and read noise (fresh in the window), quantise."""
     full = 255.0 if opts.bit_depth == 8 else 4095.0
-    dn = img * np.float32(full)
-    noise = background_noise(dn.shape, rng)
+    dn = img
+    dn *= np.float32(full)
+    bank = background_noise(dn.shape, rng)
     x0, y0, w, h = win
-    if w > 0 and h > 0:
-        noise = noise.copy()
-        noise[y0 : y0 + h, x0 : x0 + w] = rng.standard_normal((h, w), dtype=np.float32)
+    fresh = rng.standard_normal((h, w), dtype=np.float32) if w > 0 and h > 0 else None
     if opts.full_well_e:
-        sigma = np.sqrt(
-            np.float32(opts.read_noise_dn**2)
-            + np.maximum(dn, 0) * np.float32(full / opts.full_well_e)
-        )
-        dn += sigma * noise
+        gain = np.float32(full / opts.full_well_e)
+        sigma = np.sqrt(np.float32(opts.read_noise_dn**2) + np.maximum(dn, 0) * gain)
+        noise = sigma * bank
+        if fresh is not None:
+            noise[y0 : y0 + h, x0 : x0 + w] = sigma[y0 : y0 + h, x0 : x0 + w] * fresh
+        dn += noise
     elif opts.read_noise_dn > 0:
-        dn += np.float32(opts.read_noise_dn) * noise
-    np.clip(dn, 0.0, full, out=dn)
-    dtype = np.uint8 if opts.bit_depth == 8 else np.uint16
-    return (dn + np.float32(0.5)).astype(dtype)
+        read = np.float32(opts.read_noise_dn)
+        dn += read * bank
+        if fresh is not None:  # the measured region gets noise of its own
+            dn[y0 : y0 + h, x0 : x0 + w] += read * (fresh - bank[y0 : y0 + h, x0 : x0 + w])
+    np.maximum(dn, 0.0, out=dn)
+    if opts.bit_depth == 8:
+        return cv2.convertScaleAbs(dn)  # rounds and saturates at 255
+    np.minimum(dn, full, out=dn)
+    return (dn + np.float32(0.5)).astype(np.uint16)
 
 
 def _render_side(stereo, side, geo, sh, opts, rng) -> tuple[np.ndarray, tuple[int, int, int, int]]:
@@ -273,7 +278,10 @@ def render_hole_pair(
         highlight_azimuth=float(rng.uniform(0, 2 * np.pi)),
         occlusion_fraction=opts.occlusion_fraction,
         occlusion_azimuth=float(rng.uniform(0, 2 * np.pi)),
-        texture_offset=(float(rng.uniform(0, 0.03)), float(rng.uniform(0, 0.03))),
+        texture_offset=(
+            TILE_CENTER_M + float(rng.uniform(-5e-3, 5e-3)),
+            TILE_CENTER_M + float(rng.uniform(-5e-3, 5e-3)),
+        ),
     )
     left, win_l = _render_side(stereo, "left", geo, sh, opts, rng)
     right, win_r = _render_side(stereo, "right", geo.transformed(stereo.R, stereo.T), sh, opts, rng)
