@@ -91,7 +91,7 @@ class GtspLns:
     def _local(
         self, order: list[int], nodes: list[int], cost: float
     ) -> tuple[list[int], list[int], float]:
-        for _ in range(4):
+        for _ in range(2):
             path = [0, *nodes, 0]
             perm = improve_order(self.G[np.ix_(path, path)].astype(float))
             inner = [p - 1 for p in perm[1:-1]]

@@ -20,7 +20,7 @@ class Options:
         strict: raise :class:`~planner.errors.UnreachableHoleError` instead of leaving holes out.
     Sequencing:
         seed: seed of every random choice (sequencer and OMPL); the same seed gives the same tour.
-        time_budget_s: hard cap on the sequencer's search (s); ``None``: 1 s + 0.03 s per hole.
+        time_budget_s: hard cap on the sequencer's search (s); ``None``: 1 s + 0.015 s per hole.
         effort: work of the search relative to the default (iterations and patience scale with it).
         nodes_per_hole: candidate configurations per hole the search works with (the final
             choice of configuration for the found order considers every candidate).
@@ -90,7 +90,7 @@ class Options:
         """The sequencer's time cap (s) for ``n_holes`` holes."""
         if self.time_budget_s is not None:
             return float(self.time_budget_s)
-        return 1.0 + 0.03 * n_holes
+        return 1.0 + 0.015 * n_holes
 
     def to_dict(self) -> dict[str, Any]:
         """Plain mapping of every setting (stored in ``tour.json``)."""

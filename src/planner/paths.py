@@ -65,6 +65,8 @@ class MotionChecker:
         self.joint_step = joint_step_rad
         self.tcp_step = tcp_step_m
         self.checks = 0
+        self.lower = np.asarray(arm.lower, dtype=float) - 1e-9
+        self.upper = np.asarray(arm.upper, dtype=float) + 1e-9
 
     def coarser(self, factor: float) -> MotionChecker:
         """A checker on the same arm with ``factor`` times larger steps."""
@@ -73,7 +75,13 @@ class MotionChecker:
     def state_free(self, q: NDArray[np.float64]) -> bool:
         """True when ``q`` is within limits and free of collision."""
         self.checks += 1
-        return self.arm.within_limits(q) and not self.arm.in_collision(q)
+        return self._inside(q) and not self.arm.in_collision(q)
+
+    def _inside(self, Q: NDArray[np.float64]) -> bool:
+        """True when every configuration (row) lies within the joint limits."""
+        return bool(
+            np.all(np.greater_equal(Q, self.lower)) and np.all(np.less_equal(Q, self.upper))
+        )
 
     def samples(self, q_a: NDArray[np.float64], q_b: NDArray[np.float64]) -> NDArray[np.float64]:
         """Configurations on the straight segment, ends included, at the checker's resolution."""
@@ -95,7 +103,11 @@ class MotionChecker:
         Q = self.samples(np.asarray(q_a, float), np.asarray(q_b, float))
         if ends and not (self.state_free(Q[0]) and self.state_free(Q[-1])):
             return False
-        return all(self.state_free(Q[i]) for i in _interpolation_order(len(Q) - 1))
+        if not self._inside(Q):
+            return False
+        order = _interpolation_order(len(Q) - 1)
+        self.checks += len(order)
+        return not any(self.arm.in_collision(Q[i]) for i in order)
 
     def polyline_free(self, Q: NDArray[np.float64]) -> bool:
         """True when the motion through the rows of ``Q`` (straight between rows) is free."""

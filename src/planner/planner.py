@@ -35,6 +35,8 @@ ProgressCallback = Callable[[str, int, int], None]
 #: a replacement sequencer: (home q, candidates per hole, limits) -> SequenceResult
 Sequencer = Callable[[NDArray[np.float64], list[HoleCandidates], JointLimits], SequenceResult]
 STAGES = ("viewpoints", "sequence", "paths", "timing")
+#: share of the sequencing budget and effort of each re-sequencing after detours were measured
+REFINE_SHARE = 0.15
 
 
 def _no_progress(stage: str, done: int, total: int) -> None:
@@ -171,7 +173,8 @@ class TourPlanner:
             rounds += 1
             t = time.perf_counter()
             seqr.learn(measured)
-            new = seqr.solve(o.budget_s(len(cands)), o.seed + rounds, o.effort, warm=res.nodes)
+            budget = o.budget_s(len(cands)) * REFINE_SHARE
+            new = seqr.solve(budget, o.seed + rounds, o.effort * REFINE_SHARE, warm=res.nodes)
             timings["sequence"] += time.perf_counter() - t
             if new.nodes == res.nodes:
                 return route, segments, new, rounds

@@ -164,7 +164,8 @@ class GtspSequencer:
     """The GTSP of one cell: candidate nodes, their cost matrix, and repeated solves.
 
     Node 0 is home; hole h owns ``groups[h]`` (at most ``nodes_per_hole`` of its
-    candidates, spread out in travel time). :meth:`learn` replaces estimated
+    candidates, spread out in travel time, fewer when the holes times that exceed
+    ``max_nodes``: the cost matrix is dense). :meth:`learn` replaces estimated
     costs by measured ones (e.g. a segment that needed a detour around an
     obstacle) and :meth:`solve` can warm-start from a previous tour.
     """
@@ -176,6 +177,7 @@ class GtspSequencer:
         limits: JointLimits,
         nodes_per_hole: int = 16,
         method: str = "lns",
+        max_nodes: int = 2000,
     ) -> None:
         if method not in ("lns", "ortools"):
             raise PlanningError(f"unknown sequencing method {method!r} (use 'lns' or 'ortools')")
@@ -184,7 +186,8 @@ class GtspSequencer:
         self.method = method
         self.home = np.asarray(home_q, dtype=float)
         self.candidates = [np.asarray(c, dtype=float) for c in candidates]
-        self.reps = [representatives(c, nodes_per_hole, self.home, limits) for c in self.candidates]
+        k = max(min(nodes_per_hole, max_nodes // len(self.candidates)), min(nodes_per_hole, 4))
+        self.reps = [representatives(c, k, self.home, limits) for c in self.candidates]
         stacked = [c[r] for c, r in zip(self.candidates, self.reps, strict=True)]
         self.nodes = np.vstack([self.home[None, :], *stacked])
         self.owner = np.concatenate([[-1]] + [np.full(len(r), h) for h, r in enumerate(self.reps)])
@@ -228,8 +231,8 @@ class GtspSequencer:
         n = len(self.candidates)
         if self.method == "lns":
             settings = LnsSettings(
-                max_iterations=int(effort * (300 + 8 * n)),
-                patience=int(effort * (60 + 2 * n)),
+                max_iterations=int(effort * (200 + 4 * n)),
+                patience=int(effort * (50 + n)),
                 time_limit_s=time_budget_s,
             )
             start = None if warm is None else [int(self.owner[v]) for v in warm]

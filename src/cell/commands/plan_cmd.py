@@ -79,7 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=float,
         default=None,
         metavar="S",
-        help="cap on the sequencer's search time in s (default: 1 s + 0.03 s per hole)",
+        help="cap on the sequencer's search time in s (default: 1 s + 0.015 s per hole)",
     )
     p.add_argument(
         "--roll-step-deg", type=float, default=15.0, help="roll sampling about the view axis"
