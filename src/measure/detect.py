@@ -112,10 +112,10 @@ def _disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
 def _masks(small: np.ndarray):
     """(polarity, threshold 0..255, mask) for the dark class, then the bright class."""
     p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
-    if p_med - p_lo >= 0.12 * 255:
+    if p_med - p_lo >= 0.2 * 255:
         thr = p_lo + (p_med - p_lo) / 3.0
         yield "dark", thr, small <= thr
-    if p_hi - p_med >= 0.12 * 255:
+    if p_hi - p_med >= 0.2 * 255:
         thr = p_hi - (p_hi - p_med) / 3.0
         yield "bright", thr, small > thr
 
