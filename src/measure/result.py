@@ -47,12 +47,14 @@ class MeasureOptions:
 
     @classmethod
     def published(cls) -> MeasureOptions:
-        """The published method: linear interpolation, published cost, all filled points used."""
+        """The published method as described: linear interpolation, the published cost, all
+        filled points used, no curvature correction, no outlier rejection."""
         return cls(
             edge_method="linear",
             circle_cost="published",
             use_long_fills=True,
             curvature_correction=False,
+            robust=False,
         )
 
 
