@@ -43,7 +43,9 @@ def test_encode_rejects_oversize_payload() -> None:
 
 
 @settings(max_examples=300, deadline=None)
-@given(frames, st.lists(st.tuples(st.integers(0, 10_000), st.integers(0, 7)), min_size=1, max_size=8))
+@given(
+    frames, st.lists(st.tuples(st.integers(0, 10_000), st.integers(0, 7)), min_size=1, max_size=8)
+)
 def test_corrupted_frame_is_never_accepted(f: tuple[int, int, bytes], flips: list) -> None:
     wire = bytearray(fr.encode(*f))
     for pos, bit in flips:

@@ -90,7 +90,7 @@ def test_estop_latches_until_reset() -> None:
 
 
 def test_link_loss_stops_the_arm_on_the_path() -> None:
-    q, stops = _trajectory(2000)
+    q, _ = _trajectory(2000)
     with _server(speed=1.0, link_timeout_s=0.1) as sim:
         c = ControllerClient(sim.url, LinkOptions(response_timeout_s=0.03, heartbeat_period_s=60))
         c.connect()

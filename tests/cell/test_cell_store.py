@@ -1,0 +1,101 @@
+"""The results store: one row per hole, duplicates refused, corrupt files refused untouched."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from cell.report import write_report
+from cell.results import HoleResult
+from cell.store import Store, StoreError
+
+
+def _store(tmp_path: Path) -> Store:
+    holes = [("H1", 0, {"d": 0.01}), ("H2", 1, {"d": 0.01})]
+    return Store.create(tmp_path, cell_name="c", cell_sha256="abc", cell_text="name: c\n",
+                        cell_path="", tour_text="{}", reference_text="", robot_model="m",
+                        port="/dev/null", holes=holes)  # fmt: skip
+
+
+def _result(hole: str, stop: int, status: str = "ok") -> HoleResult:
+    measured = status != "missing"
+    return HoleResult(
+        hole_id=hole,
+        stop_index=stop,
+        status=status,
+        nominal_part_m=(0.1, 0.2, 0.3),
+        nominal_diameter_m=0.01,
+        tolerance_m=5e-5,
+        center_part_m=(0.1, 0.2, 0.30001) if measured else None,
+        diameter_m=0.010002 if measured else None,
+        position_deviation_m=1e-5 if measured else None,
+        diameter_deviation_m=2e-6 if measured else None,
+        q_rad=(0.0,) * 6,
+        temperatures_c=(20.0, 21.0),
+        reason="" if measured else "no hole found",
+    )
+
+
+def test_round_trip_and_no_duplicate(tmp_path: Path) -> None:
+    with _store(tmp_path) as s:
+        s.record_hole(_result("H1", 0))
+        with pytest.raises(StoreError, match="already stored"):
+            s.record_hole(_result("H1", 0))
+        with pytest.raises(StoreError, match="not planned"):
+            s.record_hole(_result("H9", 5))
+    with Store.open(tmp_path) as s:
+        assert s.stored_ids() == {"H1"}
+        assert s.results() == [_result("H1", 0)]
+        assert s.run_info()["cell_name"] == "c"
+    assert _journal(tmp_path) == "wal"
+
+
+def _journal(tmp_path: Path) -> str:
+    import sqlite3
+
+    con = sqlite3.connect(tmp_path / "results.sqlite")
+    try:
+        return con.execute("PRAGMA journal_mode").fetchone()[0]
+    finally:
+        con.close()
+
+
+def test_create_refuses_existing_run(tmp_path: Path) -> None:
+    _store(tmp_path).close()
+    with pytest.raises(StoreError, match="--resume"):
+        _store(tmp_path)
+
+
+@pytest.mark.parametrize("damage", ["garbage", "truncate"])
+def test_corrupt_store_is_refused_and_left_alone(tmp_path: Path, damage: str) -> None:
+    with _store(tmp_path) as s:
+        s.record_hole(_result("H1", 0))
+    path = tmp_path / "results.sqlite"
+    data = path.read_bytes()
+    bad = b"this is not sqlite" * 100 if damage == "garbage" else data[: len(data) // 3]
+    path.write_bytes(bad)
+    with pytest.raises(StoreError, match=r"results\.sqlite"):
+        Store.open(tmp_path)
+    assert path.read_bytes() == bad
+
+
+def test_missing_store_is_a_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(StoreError, match="not a run directory"):
+        Store.open(tmp_path)
+
+
+def test_report_files(tmp_path: Path) -> None:
+    with _store(tmp_path) as s:
+        s.record_hole(_result("H1", 0))
+        s.record_hole(_result("H2", 1, "missing"))
+        s.set_state("done", finished=True)
+    summ = write_report(tmp_path)
+    assert summ["holes_measured"] == 1 and summ["holes_missing"] == 1
+    doc = json.loads((tmp_path / "report.json").read_text())
+    assert [h["hole_id"] for h in doc["holes"]] == ["H1", "H2"]
+    rows = list(csv.DictReader((tmp_path / "report.csv").open()))
+    assert rows[0]["pass"] == "True" and rows[1]["measured_x_m"] == ""
+    assert float(rows[0]["measured_z_m"]) == pytest.approx(0.30001)
