@@ -19,7 +19,10 @@ COMMAND_MODULES: tuple[str, ...] = (
     "plan_cmd",
     "measure_cmd",
     "calibrate_cmd",
-    "run_cmd", "sim_cmd", "report_cmd", "demo_cmd",
+    "run_cmd",
+    "sim_cmd",
+    "report_cmd",
+    "demo_cmd",
 )
 
 
