@@ -18,7 +18,7 @@ import numpy as np
 
 from measure.calibration import StereoCalibration
 from measure.detect import check_image, find_candidates
-from measure.edges import _band, hole_region
+from measure.edges import hole_region, outline_band
 from measure.errors import EdgeError, HoleNotFoundError
 from measure.triangulate import triangulate_dlt
 
@@ -45,7 +45,7 @@ def _ellipse(img: np.ndarray, which: str):
         roi if roi.dtype == np.uint8 else (roi.astype(np.float32) * (255.0 / full)).astype(np.uint8)
     )
     edges = cv2.Canny(cv2.GaussianBlur(roi8, (5, 5), 1.0), 40, 100) > 0
-    ys, xs = np.nonzero(edges & _band(region.mask, 3))
+    ys, xs = np.nonzero(edges & outline_band(region.mask, 3))
     if len(xs) < 6:
         raise EdgeError(f"{which} image edges", len(xs), 6)
     pts = np.stack([xs + x0, ys + y0], axis=1).astype(np.float32)

@@ -82,7 +82,7 @@ def hole_region(
     return HoleRegion(box, centroid, float(mom["m00"]), region > 0)
 
 
-def _band(region: np.ndarray, half_width: int) -> np.ndarray:
+def outline_band(region: np.ndarray, half_width: int) -> np.ndarray:
     """Pixels within ``half_width`` of the region outline."""
     u8 = region.astype(np.uint8)
     k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * half_width + 1, 2 * half_width + 1))
@@ -105,7 +105,7 @@ def subpixel_edges(
     gx = cv2.Sobel(smooth, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(smooth, cv2.CV_32F, 0, 1, ksize=3)
     mag = cv2.magnitude(gx, gy)
-    band = _band(region.mask, 3)
+    band = outline_band(region.mask, 3)
     if not band.any():
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
     peak = float(np.percentile(mag[band], 98))
