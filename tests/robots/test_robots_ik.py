@@ -63,7 +63,7 @@ def test_every_branch_found_by_numerical_search(name: str) -> None:
     for trial, q in enumerate(rng.uniform(lower, upper, (2, 6))):
         T = fk_dh(table, q)
         analytic = solve_ik(table, T, lower, upper).solutions
-        numeric = _numerical_solutions(table, T, lower, upper, starts=60, seed=trial)
+        numeric = _numerical_solutions(table, T, lower, upper, starts=40, seed=trial)
         assert len(numeric) > 0
         for qn in numeric:
             # every numerically found solution is one of the closed-form ones (same joint values)
