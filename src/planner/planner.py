@@ -9,6 +9,7 @@ Library code reports progress through an optional callback
 from __future__ import annotations
 
 import hashlib
+import itertools
 import logging
 import time
 from collections.abc import Callable
@@ -37,6 +38,11 @@ Sequencer = Callable[[NDArray[np.float64], list[HoleCandidates], JointLimits], S
 STAGES = ("viewpoints", "sequence", "paths", "timing")
 #: share of the sequencing budget and effort of each re-sequencing after detours were measured
 REFINE_SHARE = 0.15
+#: lazy edge checks are this many times coarser than the set motion resolution
+LAZY_COARSENESS = 6.0
+#: estimated duration of a colliding straight edge until its detour is measured: factor, extra s
+DETOUR_FACTOR = 1.5
+DETOUR_EXTRA_S = 0.3
 
 
 def _no_progress(stage: str, done: int, total: int) -> None:
@@ -136,6 +142,31 @@ class TourPlanner:
             self.progress("paths", k + 1, len(points) - 1)
         return out
 
+    def _avoid_colliding_edges(
+        self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker, n_holes: int
+    ) -> SequenceResult:
+        """Lazy collision checking: penalise tour edges whose straight segment collides
+        (checked ``LAZY_COARSENESS`` times coarser than the set resolution), re-sequence."""
+        o = self.options
+        coarse = checker.coarser(LAZY_COARSENESS)
+        for k in range(o.refine_rounds):
+            path = [0, *(res.nodes or []), 0]
+            penalties = {}
+            for u, v in itertools.pairwise(path):
+                key = (min(u, v), max(u, v))
+                if key not in self._edge_free:
+                    self._edge_free[key] = coarse.segment_free(seqr.nodes[u], seqr.nodes[v])
+                if not self._edge_free[key] and (u, v) not in seqr.learned:
+                    penalties[(u, v)] = DETOUR_FACTOR * seqr.G[u, v] + DETOUR_EXTRA_S
+            checker.checks += coarse.checks
+            coarse.checks = 0
+            if not penalties:
+                break
+            seqr.learn(penalties)
+            budget = o.budget_s(n_holes) * REFINE_SHARE
+            res = seqr.solve(budget, o.seed + 100 + k, o.effort * REFINE_SHARE, warm=res.nodes)
+        return res
+
     def _sequence_and_paths(
         self,
         home: NDArray[np.float64],
@@ -144,19 +175,22 @@ class TourPlanner:
         cache: SegmentCache,
         timings: dict[str, float],
     ) -> tuple[_Route, list[Segment], SequenceResult, int]:
-        """Sequence, plan the segments, feed measured detours back, re-sequence (see Options)."""
+        """Sequence, avoid colliding edges, plan the segments, feed measured detours back."""
         o = self.options
         t = time.perf_counter()
         self.progress("sequence", 0, 1)
+        self._edge_free: dict[tuple[int, int], bool] = {}
         if self.sequencer is not None:
             res = self.sequencer(home, cands, limits)
             seqr = None
         else:
             seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
             res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort)
+            res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
         self.progress("sequence", 1, 1)
         timings["sequence"] = time.perf_counter() - t
         rounds = 0
+        measured_pairs: set[tuple[int, int]] = set()
         while True:
             route = self._route(cands, res)
             segments = self._segments(home, route, cache)
@@ -166,12 +200,14 @@ class TourPlanner:
             measured = {
                 (path_nodes[k], path_nodes[k + 1]): seg.motion.duration
                 for k, seg in enumerate(segments)
-                if seg.path.planned and (path_nodes[k], path_nodes[k + 1]) not in seqr.learned
+                if seg.path.planned and (path_nodes[k], path_nodes[k + 1]) not in measured_pairs
             }
             if not measured:
                 return route, segments, res, rounds
             rounds += 1
             t = time.perf_counter()
+            measured_pairs.update(measured)
+            measured_pairs.update((v, u) for u, v in measured)
             seqr.learn(measured)
             budget = o.budget_s(len(cands)) * REFINE_SHARE
             new = seqr.solve(budget, o.seed + rounds, o.effort * REFINE_SHARE, warm=res.nodes)
