@@ -14,6 +14,7 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 
@@ -34,6 +35,7 @@ from robots.thermal.model import ThermalModel
 from robots.transforms import invert
 
 log = logging.getLogger(__name__)
+T = TypeVar("T")
 
 
 class RunFaultError(CellError):
@@ -129,6 +131,7 @@ class Runner:
         self.thermal = ThermalUpdate(cell, self.arm, self.options.reference_c)
         self._T_head_left = invert(head_frame(camera.stereo))
         self._loaded: Tour | None = None
+        self._need_load = False
 
     # --- the state machine -----------------------------------------------------------------
     def run(self, wait_for_start: Callable[[], None] | None = None) -> RunResult:
@@ -177,22 +180,37 @@ class Runner:
 
     # --- motion ----------------------------------------------------------------------------
     def _load(self, tour: Tour) -> None:
-        rows = stop_rows(tour)
-        self.client.load_trajectory(tour.trajectory, rows, tour.dt)
-        self._loaded = tour
+        self._loaded, self._need_load = tour, True
+        self._call("load trajectory", self._ensure_loaded)
+
+    def _ensure_loaded(self) -> None:
+        if self._need_load and self._loaded is not None:
+            self.client.load_trajectory(self._loaded.trajectory, stop_rows(self._loaded),
+                                        self._loaded.dt)  # fmt: skip
+            self._need_load = False
+
+    def _call(self, where: str, fn: Callable[[], T]) -> T:
+        """``fn()`` on the link, reconnecting (and reloading) while the link is dead."""
+        while True:
+            try:
+                self._ensure_loaded()
+                return fn()
+            except LinkError as exc:
+                self._recover(exc, where)
 
     def _move(self, k: int, where: str) -> m.Status:
         """Bring the arm to stop ``k`` of the loaded tour, surviving a dead link."""
         deadline = time.monotonic() + self.options.move_timeout_s
+
+        def go() -> m.Status:
+            self.client.move_to_stop(k)
+            return self.client.wait_in_position(k, self.options.move_timeout_s)
+
         while True:
             try:
-                self.client.move_to_stop(k)
-                st = self.client.wait_in_position(k, self.options.move_timeout_s)
-            except LinkError as exc:
-                self._recover(exc, where)
-                continue
+                st = self._call(where, go)
             except RequestRefusedError as exc:
-                st = self.client.status()
+                st = self._call(where, self.client.status)
                 if st.state in (m.State.ESTOP, m.State.FAULT):
                     raise RunFaultError(where, st.state.name, st.fault.name) from exc
                 raise
@@ -205,10 +223,10 @@ class Runner:
                 raise RunFaultError(where, st.state.name, "move timed out")
 
     def _recover(self, exc: LinkError, where: str) -> None:
+        """Reconnect within the budget (LinkError beyond it); the trajectory is reloaded."""
         self.store.event("link", f"{where}: {exc}; reconnecting")
         self.client.reconnect(self.options.reconnect_budget_s)
-        if self._loaded is not None:
-            self._load(self._loaded)
+        self._need_load = True
         self.store.event("link", f"{where}: link restored")
 
     def _safe_stop(self) -> None:
@@ -219,14 +237,14 @@ class Runner:
 
     def _settled_status(self) -> m.Status:
         time.sleep(self.options.settle_s)
-        return self.client.status()
+        return self._call("status", self.client.status)
 
     # --- reference targets -----------------------------------------------------------------
     def _reference_phase(self) -> None:
         tour = self.reference_tour
         self._load(tour)
         for rnd in range(self.options.reference_rounds):
-            t_start = self.client.status().time_s
+            t_start = self._call("status", self.client.status).time_s
             for k, s in enumerate(tour.stops):
                 self._move(k, f"reference {s.hole_id}")
                 st = self._settled_status()
@@ -245,7 +263,7 @@ class Runner:
                 self._wait_controller_time(t_start + self.options.reference_interval_s)
 
     def _wait_controller_time(self, t_s: float) -> None:
-        while self.client.status().time_s < t_s:
+        while self._call("status", self.client.status).time_s < t_s:
             time.sleep(0.01)
 
     def _identify(self) -> str:

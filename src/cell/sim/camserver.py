@@ -33,6 +33,12 @@ class CameraServer:
         self._thread.start()
         return self
 
+    def __enter__(self) -> CameraServer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
     def close(self) -> None:
         """Stop serving."""
         self._stop.set()
@@ -66,7 +72,11 @@ class CameraServer:
             while b"\n" in buf:
                 line, buf = buf.split(b"\n", 1)
                 if line.strip() == b"CAPTURE":
-                    self._answer(conn)
+                    try:
+                        self._answer(conn)
+                    except OSError as exc:  # the client went away mid-transfer
+                        log.info("camera client lost: %s", exc)
+                        return
 
     def _answer(self, conn: socket.socket) -> None:
         try:
