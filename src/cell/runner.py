@@ -73,12 +73,14 @@ class RunOptions:
 @dataclass
 class RunResult:
     """Outcome of :meth:`Runner.run`: status (``done`` / ``fault``), holes stored by this call,
-    holes skipped as already stored, timings (s) and link counters."""
+    holes skipped as already stored, timings (s; per hole: move, settle, capture, inspect (of it
+    the measurement itself: measure_s), store, record) and link counters."""
 
     status: str
     stored: list[HoleResult] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
     timings: dict[str, float] = field(default_factory=dict)
+    hole_timings: list[dict[str, float]] = field(default_factory=list)
     link: dict[str, int] = field(default_factory=dict)
     thermal: str = ""
 
@@ -152,7 +154,9 @@ class Runner:
             self._state("inspecting")
             self._load(self.tour)
             for k in todo:
-                result.stored.append(self._inspect_stop(k))
+                hole, laps = self._inspect_stop(k)
+                result.stored.append(hole)
+                result.hole_timings.append(laps)
             self._state("homing")
             self._move(len(self.tour.stops), "home")
             self.store.set_state("done", finished=True)
@@ -282,28 +286,37 @@ class Runner:
         return msg
 
     # --- one hole --------------------------------------------------------------------------
-    def _inspect_stop(self, k: int) -> HoleResult:
+    def _inspect_stop(self, k: int) -> tuple[HoleResult, dict[str, float]]:
+        """Move, settle, capture, measure, compensate, compare, store, record one stop; returns
+        the result and the wall time (s) of each step."""
         stop = self.tour.stops[k]
+        clock = _Laps()
         self._move(k, f"stop {k} ({stop.hole_id})")
+        clock.lap("move_s")
         st = self._settled_status()
+        clock.lap("settle_s")
         pair = self.camera.capture()
-        hole = self.holes[stop.hole_id]
-        result, meas = inspect(
-            self.cell,
-            self.arm,
-            self.model,
-            self.camera.stereo,
-            hole,
-            k,
-            pair.left,
-            pair.right,
-            st.q_rad,
-            st.temperatures_c,
-            st.time_s,
-        )
+        clock.lap("capture_s")
+        result, meas = inspect(self.cell, self.arm, self.model, self.camera.stereo,
+                               self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
+                               st.temperatures_c, st.time_s)  # fmt: skip
+        clock.lap("inspect_s")
         self.store.record_hole(result)
+        clock.lap("store_s")
         if self.recorder is not None:
             T = T_cell_tcp(self.arm, self.model, st.q_rad, st.temperatures_c)
             self.recorder.hole(result, meas, pair, st, T @ self._T_head_left)
+        clock.lap("record_s")
         self.progress("hole", {"stop": k, "result": result})
-        return result
+        clock.laps["measure_s"] = result.measure_time_s
+        return result, clock.laps
+
+
+class _Laps:
+    def __init__(self) -> None:
+        self.laps: dict[str, float] = {}
+        self._t = time.perf_counter()
+
+    def lap(self, name: str) -> None:
+        t = time.perf_counter()
+        self.laps[name], self._t = t - self._t, t
