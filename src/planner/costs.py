@@ -112,10 +112,14 @@ class CostTable:
         rows = np.atleast_2d(np.asarray(q_rows, dtype=float))
         cols = np.atleast_2d(np.asarray(q_cols, dtype=float))
         out = np.zeros((rows.shape[0], cols.shape[0]), dtype=np.float32)
+        delta = np.empty_like(out)
+        idx = np.empty(out.shape, dtype=np.int32)
         for k, table in enumerate(self.tables):
-            delta = np.abs(
-                np.subtract.outer(rows[:, k] * self.inv_step, cols[:, k] * self.inv_step)
-            )
-            idx = np.minimum(delta.astype(np.int32), len(table) - 1)
+            a = (rows[:, k] * self.inv_step).astype(np.float32)
+            b = (cols[:, k] * self.inv_step).astype(np.float32)
+            np.subtract(a[:, None], b[None, :], out=delta)
+            np.abs(delta, out=delta)
+            np.minimum(delta, np.float32(len(table) - 1), out=delta)
+            idx[...] = delta
             np.maximum(out, table[idx], out=out)
         return out

@@ -38,8 +38,10 @@ Sequencer = Callable[[NDArray[np.float64], list[HoleCandidates], JointLimits], S
 STAGES = ("viewpoints", "sequence", "paths", "timing")
 #: share of the sequencing budget and effort of each re-sequencing after detours were measured
 REFINE_SHARE = 0.15
+#: at most this many lazy re-sequencing rounds (and at most the sequencing budget in time)
+LAZY_ROUNDS = 12
 #: lazy edge checks are this many times coarser than the set motion resolution
-LAZY_COARSENESS = 6.0
+LAZY_COARSENESS = 3.0
 #: estimated duration of a colliding straight edge until its detour is measured: factor, extra s
 DETOUR_FACTOR = 1.5
 DETOUR_EXTRA_S = 0.3
@@ -149,7 +151,10 @@ class TourPlanner:
         (checked ``LAZY_COARSENESS`` times coarser than the set resolution), re-sequence."""
         o = self.options
         coarse = checker.coarser(LAZY_COARSENESS)
-        for k in range(o.refine_rounds):
+        started = time.perf_counter()
+        for k in range(LAZY_ROUNDS):
+            if time.perf_counter() - started > o.budget_s(n_holes):
+                break
             path = [0, *(res.nodes or []), 0]
             penalties = {}
             for u, v in itertools.pairwise(path):

@@ -177,7 +177,7 @@ class GtspSequencer:
         limits: JointLimits,
         nodes_per_hole: int = 16,
         method: str = "lns",
-        max_nodes: int = 2000,
+        max_nodes: int = 4000,
     ) -> None:
         if method not in ("lns", "ortools"):
             raise PlanningError(f"unknown sequencing method {method!r} (use 'lns' or 'ortools')")
