@@ -46,7 +46,6 @@ class DemoOptions:
         reference_interval_s: simulated seconds between two rounds.
         faults: what the simulated controller does wrong (none by default).
         seed: seed of the part's true geometry, sensor noise and image noise.
-        record: write ``run.rrd``.
     """
 
     warmup_speed: float = 1500.0
@@ -55,7 +54,6 @@ class DemoOptions:
     reference_interval_s: float = 900.0
     faults: FaultPlan = field(default_factory=FaultPlan)
     seed: int = 0
-    record: bool = True
 
 
 @dataclass

@@ -27,6 +27,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default=None, help="run directory (default: out/demo-<time>)")
     p.add_argument("--seed", type=int, default=0, help="seed of the simulated part and noise")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
+    p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
+    p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.set_defaults(handler=run_demo_cmd)
 
@@ -39,12 +41,15 @@ def _plan_bars(quiet: bool):
     return StageBars()
 
 
-def _recorder_factory(enabled: bool):
-    if not enabled:
+def _recorder_factory(args: argparse.Namespace):
+    if args.no_record:
         return None
     from cell.record import Recorder
 
-    return lambda run_dir, cell, tour: Recorder.create(run_dir / "run.rrd", cell, tour)
+    def factory(run_dir: Path, cell, tour):
+        return Recorder.create(run_dir / "run.rrd", cell, tour, args.spawn, args.connect)
+
+    return factory
 
 
 def format_demo(res: DemoResult) -> str:
@@ -76,10 +81,10 @@ def run_demo_cmd(args: argparse.Namespace) -> int:
     bars = None if args.quiet else RunBars(0)
     res = run_demo(
         out,
-        DemoOptions(seed=args.seed, record=not args.no_record),
+        DemoOptions(seed=args.seed),
         _plan_bars(args.quiet),
         _progress(bars),
-        _recorder_factory(not args.no_record),
+        _recorder_factory(args),
     )
     print(format_demo(res))
     if not args.no_record:

@@ -11,6 +11,7 @@ from cell.commands.run_progress import RunBars
 from cell.config import load_cell
 from cell.errors import CellError
 from cell.link.client import ControllerClient
+from cell.record import Recorder
 from cell.reference import plan_reference_tour
 from cell.report import format_summary, write_report
 from cell.run_setup import RunFiles, resume_run, start_run
@@ -31,7 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "socket://host:port or a pty path) and the stereo head at --camera, measures the "
             "reference targets and updates the thermal compensation, then measures every hole. "
             "Writes RUN_DIR/results.sqlite (every hole in its own transaction), report.json "
-            "and report.csv. --resume RUN_DIR continues a stopped run from the first hole not "
+            "and report.csv, and records the run to RUN_DIR/run.rrd (Rerun; --spawn or --connect "
+            "to watch it live). --resume RUN_DIR continues a stopped run from the first hole not "
             "stored, with the cell and tour stored in it."
         ),
     )
@@ -46,6 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--reference-interval-s", type=float, default=300.0,
                    help="controller seconds between reference rounds")  # fmt: skip
     p.add_argument("--settle-s", type=float, default=0.2, help="settling wait (s)")
+    p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
+    p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
+    p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
     p.add_argument("--yes", action="store_true", help="start without asking")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.set_defaults(handler=run_run)
@@ -67,6 +72,14 @@ def _files(args: argparse.Namespace) -> RunFiles:
     return start_run(out, cell, tour, args.tour, args.port, reference)
 
 
+def _rrd_path(run_dir: Path) -> Path:
+    """``run.rrd``; a resumed run records to ``run.resumed-N.rrd`` next to it."""
+    path, n = run_dir / "run.rrd", 1
+    while path.exists():
+        path, n = run_dir / f"run.resumed-{n}.rrd", n + 1
+    return path
+
+
 def _ask_start() -> None:
     input("press Enter to start the run (Ctrl-C to cancel) ")
 
@@ -78,7 +91,7 @@ def run_run(args: argparse.Namespace) -> int:
     model = load_model(args.thermal) if args.thermal else None
     stored = len(files.store.stored_ids())
     client = ControllerClient(args.port)
-    camera = None
+    camera = recorder = None
     try:
         client.connect()
         if client.identity.robot_model != files.cell.robot.model:
@@ -93,13 +106,20 @@ def run_run(args: argparse.Namespace) -> int:
             reference_interval_s=args.reference_interval_s,
         )
         progress = None if args.quiet else RunBars(len(files.tour.stops), stored)
+        if not args.no_record:
+            recorder = Recorder.create(_rrd_path(run_dir), files.cell, files.tour, args.spawn,
+                                       args.connect)  # fmt: skip
         runner = Runner(files.cell, files.tour, files.store, client, camera, options,
-                        files.reference, model, progress)  # fmt: skip
-        runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
+                        files.reference, model, progress, recorder)  # fmt: skip
+        result = runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
+        if result.thermal:
+            print(result.thermal)
     finally:
         client.close()
         if camera is not None:
             camera.close()
+        if recorder is not None:
+            recorder.close()
         files.store.close()
     print(format_summary(write_report(run_dir)))
     print(f"run directory: {run_dir}")
