@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/holecell cell show
+	$(VENV)/bin/holecell demo
 
 test: $(STAMP)
 	$(PY) -m pytest -q
