@@ -1,9 +1,10 @@
 """Rerun recording of a run: ``run.rrd`` in the run directory, optionally a live viewer too.
 
-What is logged (entity paths; 3D in the robot base frame, which is the cell frame when the base
-sits at the cell origin, m):
+What is logged (entity paths; 3D in the cell frame, m; the URDF's root frame ``base_link`` is
+attached to the scene root by ``T_cell_base``):
 
-- ``robot``: the arm from its URDF (static); joint transforms on ``transforms`` at every stop
+- ``<robot model>``: the arm from its URDF, by Rerun's URDF importer (static); joint transforms
+  (named frames) on ``transforms`` at every stop
   (timeline ``run_time``, the controller clock in s) and along the planned trajectory
   (timeline ``tour_time``, s, every 0.1 s).
 - ``cell/obstacles/*``: part and environment obstacles; ``cell/holes``: nominal holes and normals.
@@ -30,7 +31,6 @@ from cell.config import CellConfig
 from cell.results import HoleResult
 from planner import Tour
 from robots import Shape
-from robots.transforms import invert
 
 log = logging.getLogger(__name__)
 
@@ -45,7 +45,7 @@ def blueprint() -> rrb.Blueprint:
             rrb.Spatial3DView(
                 name="cell",
                 origin="/",
-                contents=["/robot/**", "/cell/**", "/tour/**", "/run/**", "/transforms/**"],
+                contents=["+ /**", "- /camera/**", "- /plots/**", "- /run/state"],
             ),
             rrb.Vertical(
                 rrb.Horizontal(
@@ -70,7 +70,7 @@ class Recorder:
         self.cell = cell
         self.tour = tour
         self.arm = cell.build_arm()
-        self.T_base_cell = invert(cell.T_cell_base())
+        self.T_view_cell = np.eye(4)  # the 3D scene is logged in the cell frame
         self.urdf = rr.urdf.UrdfTree.from_file_path(self.arm.urdf_path)
         self.joints = {j.name: j for j in self.urdf.joints()}
 
@@ -104,16 +104,25 @@ class Recorder:
     # --- static scene -----------------------------------------------------------------------
     def _p(self, p_cell: np.ndarray) -> np.ndarray:
         p = np.asarray(p_cell, float).reshape(-1, 3)
-        return p @ self.T_base_cell[:3, :3].T + self.T_base_cell[:3, 3]
+        return p @ self.T_view_cell[:3, :3].T + self.T_view_cell[:3, 3]
 
     def _static(self) -> None:
         rec = self.rec
         rec.log_file_from_path(self.arm.urdf_path, static=True)
+        # attach the URDF's root frame to the scene root (the cell frame) at the base pose
+        T = np.asarray(self.cell.T_cell_base(), float)
+        root = rr.Transform3D(
+            translation=T[:3, 3],
+            quaternion=rr.Quaternion(xyzw=_quat_xyzw(T[:3, :3])),
+            parent_frame="tf#/",
+            child_frame=self.urdf.root_link().name,
+        )
+        rec.log("transforms/base", root, static=True)
         for i, shape in enumerate(self.cell.obstacle_shapes()):
             self._shape(f"cell/obstacles/{i}_{shape.name}", shape)
         holes = self.cell.holes_in_cell()
         pos = self._p(np.array([h.position_m for h in holes]))
-        nrm = np.array([h.normal for h in holes]) @ self.T_base_cell[:3, :3].T
+        nrm = np.array([h.normal for h in holes]) @ self.T_view_cell[:3, :3].T
         rec.log(
             "cell/holes",
             rr.Points3D(pos, radii=0.003, labels=[h.id for h in holes], colors=[80, 160, 255]),
@@ -137,7 +146,7 @@ class Recorder:
             self._joints(self.tour.trajectory[i])
 
     def _shape(self, path: str, s: Shape) -> None:
-        T = self.T_base_cell @ np.asarray(s.T, float)
+        T = self.T_view_cell @ np.asarray(s.T, float)
         quat = rr.Quaternion(xyzw=_quat_xyzw(T[:3, :3]))
         kind = s.kind
         if kind == "box":
@@ -188,7 +197,7 @@ class Recorder:
         rec.log("plots/deviation/position", rr.Scalars(result.position_deviation_m * 1e6))
         rec.log("plots/deviation/diameter", rr.Scalars(result.diameter_deviation_m * 1e6))
         self._images(meas, pair)
-        T = self.T_base_cell @ T_cell_left
+        T = self.T_view_cell @ T_cell_left
         pts = meas.points_m[meas.inliers] @ T[:3, :3].T + T[:3, 3]
         rec.log("run/hole/points", rr.Points3D(pts, radii=0.0002, colors=[0, 200, 255]))
         rec.log(
