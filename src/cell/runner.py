@@ -214,6 +214,10 @@ class Runner:
             try:
                 st = self._call(where, go)
             except RequestRefusedError as exc:
+                if exc.code == m.Nak.NOT_LOADED:  # the controller lost the trajectory
+                    self.store.event("motion", f"{where}: {exc}; reloading")
+                    self._need_load = True
+                    continue
                 st = self._call(where, self.client.status)
                 if st.state in (m.State.ESTOP, m.State.FAULT):
                     raise RunFaultError(where, st.state.name, st.fault.name) from exc

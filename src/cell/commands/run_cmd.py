@@ -11,11 +11,12 @@ from cell.commands.run_progress import RunBars
 from cell.config import load_cell
 from cell.errors import CellError
 from cell.link.client import ControllerClient
+from cell.link.errors import LinkError
 from cell.record import Recorder
 from cell.reference import plan_reference_tour
 from cell.report import format_summary, write_report
 from cell.run_setup import RunFiles, resume_run, start_run
-from cell.runner import Runner, RunOptions
+from cell.runner import RunFaultError, Runner, RunOptions
 from cell.sim.session import cell_stereo
 from planner import load_tour
 from robots.thermal.modelfile import load_model
@@ -111,7 +112,12 @@ def run_run(args: argparse.Namespace) -> int:
                                        args.connect)  # fmt: skip
         runner = Runner(files.cell, files.tour, files.store, client, camera, options,
                         files.reference, model, progress, recorder)  # fmt: skip
-        result = runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
+        try:
+            result = runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
+        except (RunFaultError, LinkError):
+            files.store.close()
+            print(format_summary(write_report(run_dir)), file=sys.stderr)
+            raise
         if result.thermal:
             print(result.thermal)
     finally:
