@@ -145,6 +145,10 @@ class GtspLns:
             nodes.insert(e, int(cand[c]))
         return order
 
+    def _path_cost(self, nodes: list[int]) -> float:
+        path = np.array([0, *nodes, 0])
+        return float(self.G[path[:-1], path[1:]].sum())
+
     def run(self, settings: LnsSettings, start: list[int] | None = None) -> LnsResult:
         """Search from ``start`` (a hole order) or the greedy tour; returns the best tour found."""
         started = time.perf_counter()
@@ -160,7 +164,8 @@ class GtspLns:
             iterations = it + 1
             k = int(self.rng.integers(1, max(2, min(settings.max_removed, n // 3)) + 1))
             order, nodes, removed = self._remove(cur[0], cur[1], k)
-            new = self._local(*self._rechoose(self._insert(order, nodes, removed)))
+            order = self._insert(order, nodes, removed)  # inserts into nodes too
+            new = self._local(order, nodes, self._path_cost(nodes))
             threshold = settings.start_threshold * best[2] * (1 - it / settings.max_iterations)
             if new[2] < cur[2] + threshold:
                 cur = new

@@ -1,11 +1,13 @@
 """Order improvement with fixed configurations: 2-opt and or-opt, vectorised in numpy.
 
 A tour is the path ``Q = [home, q_1, ..., q_n, home]`` (rad); ``C`` is its matrix of
-symmetric rest-to-rest travel times (s). Moves keep both home ends in place and
-are applied best-improvement first until none improves by more than ``eps`` s.
+symmetric travel times (s). Moves keep both home ends in place and are applied
+best-improvement first until none improves by more than ``EPS_S``.
 """
 
 from __future__ import annotations
+
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -13,40 +15,48 @@ from numpy.typing import NDArray
 EPS_S = 1e-9
 
 
+@lru_cache(maxsize=64)
+def _two_opt_mask(m: int) -> NDArray[np.float64]:
+    """0 where the 2-opt move (i, j) is valid (j >= i + 2), inf elsewhere."""
+    return np.where(np.triu(np.ones((m, m), dtype=bool), k=2), 0.0, np.inf)
+
+
+@lru_cache(maxsize=64)
+def _or_opt_mask(m: int, length: int) -> NDArray[np.float64]:
+    """0 where segment i may go to edge j (j outside [i-1, i+length-1]), inf elsewhere."""
+    starts = np.arange(1, m - length + 1)
+    j = np.arange(m)
+    bad = (j[None, :] >= starts[:, None] - 1) & (j[None, :] <= starts[:, None] + length - 1)
+    return np.where(bad, np.inf, 0.0)
+
+
 def best_two_opt(C: NDArray[np.float64]) -> tuple[float, int, int]:
     """Best 2-opt move on path costs ``C``: reverse ``Q[i+1 .. j]``. Returns (delta_s, i, j)."""
     m = C.shape[0] - 1  # number of edges
     edge = C[np.arange(m), np.arange(1, m + 1)]
-    delta = C[:m, :m] + C[1:, 1:] - edge[:, None] - edge[None, :]
-    delta = np.where(np.triu(np.ones((m, m), dtype=bool), k=2), delta, np.inf)
-    flat = int(np.argmin(delta))
-    i, j = divmod(flat, m)
+    delta = C[:m, :m] + C[1:, 1:] - edge[:, None] - edge[None, :] + _two_opt_mask(m)
+    i, j = divmod(int(np.argmin(delta)), m)
     return float(delta[i, j]), i, j
 
 
 def best_or_opt(C: NDArray[np.float64], length: int) -> tuple[float, int, int, bool]:
     """Best move of a segment ``Q[i .. i+length-1]`` to the edge (j, j+1), maybe reversed.
 
-    Returns (delta_s, i, j, reversed). Home ends (0 and last) never move.
+    ``C`` must be symmetric. Returns (delta_s, i, j, reversed). Home ends never move.
     """
     m = C.shape[0] - 1
-    starts = np.arange(1, m - length + 1)  # segment must end before the final home
-    if len(starts) == 0 or m < 2:
+    if m - length < 1 or m < 2:
         return np.inf, 0, 0, False
+    starts = np.arange(1, m - length + 1)
     ends = starts + length - 1
     removal = C[starts - 1, ends + 1] - C[starts - 1, starts] - C[ends, ends + 1]
-    j = np.arange(m)
-    edge = C[j, j + 1]
-    fwd = C[j[None, :], starts[:, None]] + C[ends[:, None], j[None, :] + 1] - edge[None, :]
-    rev = C[j[None, :], ends[:, None]] + C[starts[:, None], j[None, :] + 1] - edge[None, :]
-    bad = (j[None, :] >= starts[:, None] - 1) & (j[None, :] <= ends[:, None])
-    fwd = np.where(bad, np.inf, fwd) + removal[:, None]
-    rev = np.where(bad, np.inf, rev) + removal[:, None]
-    use_rev = rev < fwd
-    best = np.where(use_rev, rev, fwd)
-    flat = int(np.argmin(best))
-    a, b = divmod(flat, m)
-    return float(best[a, b]), int(starts[a]), int(b), bool(use_rev[a, b])
+    edge = C[np.arange(m), np.arange(1, m + 1)]
+    base = removal[:, None] - edge[None, :] + _or_opt_mask(m, length)
+    fwd = C[starts, :m] + C[ends, 1:] + base  # j -> start ... end -> j+1
+    rev = C[ends, :m] + C[starts, 1:] + base  # j -> end ... start -> j+1
+    best = np.minimum(fwd, rev)
+    a, b = divmod(int(np.argmin(best)), m)
+    return float(best[a, b]), int(starts[a]), int(b), bool(rev[a, b] < fwd[a, b])
 
 
 def apply_two_opt(perm: list[int], i: int, j: int) -> list[int]:
