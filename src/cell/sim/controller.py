@@ -23,6 +23,9 @@ log = logging.getLogger(__name__)
 
 #: a joint vector lies on the trajectory if every joint is within this of a row (micro-degrees)
 ON_PATH_TOL_UDEG = 1000
+#: largest trajectory the simulated controller holds (rows, about 13 min at 4 ms) and stops
+MAX_ROWS = 200_000
+MAX_STOPS = 5_000
 
 
 @dataclass
@@ -168,8 +171,11 @@ class SimController:
         traj_id, n_rows, n_stops, dt_us = m._unpack(m.LOAD_BEGIN, p, m.Msg.LOAD_BEGIN)
         if traj_id == self.s.traj_id and self.s.rows is not None:
             return b"\x01"
-        if n_rows < 2 or dt_us <= 0:
-            raise PayloadError(m.Msg.LOAD_BEGIN, f"{n_rows} rows at dt {dt_us} us")
+        if not 2 <= n_rows <= MAX_ROWS or n_stops > MAX_STOPS or dt_us <= 0:
+            raise PayloadError(
+                m.Msg.LOAD_BEGIN,
+                f"{n_rows} rows (2..{MAX_ROWS}), {n_stops} stops (<= {MAX_STOPS}), dt {dt_us} us",
+            )
         self._load = _Load(
             traj_id,
             np.zeros((n_rows, 6)),
