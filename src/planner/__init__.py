@@ -9,11 +9,12 @@ from planner.errors import (
     PlanningError,
     SegmentPlanningError,
     StartConfigurationError,
+    TourCellMismatchError,
     TourFileError,
     UnreachableHoleError,
 )
 from planner.options import Options
-from planner.planner import STAGES, TourPlanner, plan_tour
+from planner.planner import STAGES, TourPlanner, cell_sha256, check_tour_for_cell, plan_tour
 from planner.tour import LeftOut, Stop, Tour, load_tour
 
 __all__ = [
@@ -26,9 +27,12 @@ __all__ = [
     "StartConfigurationError",
     "Stop",
     "Tour",
+    "TourCellMismatchError",
     "TourFileError",
     "TourPlanner",
     "UnreachableHoleError",
+    "cell_sha256",
+    "check_tour_for_cell",
     "load_tour",
     "plan_tour",
 ]

@@ -77,3 +77,16 @@ class TourFileError(PlanningError):
         self.path = path
         self.field = field
         super().__init__(f"{path}: {field}: {message}")
+
+
+class TourCellMismatchError(PlanningError):
+    """A tour was planned for another cell (or robot) than the one it is about to run on."""
+
+    def __init__(self, field: str, tour_value: object, cell_value: object) -> None:
+        self.field = field
+        self.tour_value = tour_value
+        self.cell_value = cell_value
+        super().__init__(
+            f"the tour does not belong to this cell: {field} is {tour_value!r} in the tour, "
+            f"{cell_value!r} in the cell; plan the tour again for this cell"
+        )

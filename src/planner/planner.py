@@ -19,7 +19,12 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from planner.errors import NoReachableHoleError, StartConfigurationError, UnreachableHoleError
+from planner.errors import (
+    NoReachableHoleError,
+    StartConfigurationError,
+    TourCellMismatchError,
+    UnreachableHoleError,
+)
 from planner.options import Options
 from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
@@ -61,6 +66,21 @@ def cell_sha256(cell: CellLike) -> str:
         ]
         text = repr((cell.name, cell.robot.model, cell.home_q().round(9).tolist(), holes))
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def check_tour_for_cell(tour: Tour, cell: CellLike) -> None:
+    """Raise :class:`TourCellMismatchError` unless ``tour`` was planned for exactly ``cell``.
+
+    Compares the robot model, the cell name and the SHA-256 of the cell file text.
+    """
+    checks = (
+        ("robot model", tour.robot_model, cell.robot.model),
+        ("cell name", tour.cell_name, cell.name),
+        ("cell sha256", tour.cell_sha256, cell_sha256(cell)),
+    )
+    for field, in_tour, in_cell in checks:
+        if in_tour != in_cell:
+            raise TourCellMismatchError(field, in_tour, in_cell)
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,15 @@ import pytest
 import yaml
 
 from cell.config import builtin_cell_path, load_builtin_cell, parse_cell
-from planner import Options, Tour, UnreachableHoleError, load_tour, plan_tour
+from planner import (
+    Options,
+    Tour,
+    TourCellMismatchError,
+    UnreachableHoleError,
+    check_tour_for_cell,
+    load_tour,
+    plan_tour,
+)
 from planner.timing import JointLimits
 from planner.trajectory import finite_difference_limits
 
@@ -92,6 +100,19 @@ def test_tour_file_identifies_the_cell_and_round_trips(builtin, tmp_path: Path) 
     assert back.hole_order == tour.hole_order
     assert np.array_equal(back.trajectory, tour.trajectory)
     assert set(tour.timings_s) == {"viewpoints", "sequence", "paths", "timing"}
+
+
+def test_a_tour_is_refused_for_another_cell(builtin) -> None:
+    cell, tour = builtin
+    check_tour_for_cell(tour, cell)
+    other = _small_cell([], keep=3)
+    with pytest.raises(TourCellMismatchError, match="cell name"):
+        check_tour_for_cell(tour, other)
+    data = yaml.safe_load(cell.raw_text)
+    data["part"]["holes"][0]["position"][0] += 0.001  # same name, moved hole
+    moved = parse_cell(yaml.safe_dump(data), "<moved>")
+    with pytest.raises(TourCellMismatchError, match="sha256"):
+        check_tour_for_cell(tour, moved)
 
 
 def test_unreachable_and_colliding_holes_are_left_out_with_reasons() -> None:
