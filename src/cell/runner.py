@@ -278,6 +278,9 @@ class Runner:
         model = self.thermal.identify()
         if model is None:
             msg = f"thermal model not updated: {self.thermal.refusal}"
+            if self.model is not None and self.thermal.rows:
+                rms = self.thermal.check(self.model)
+                msg += f"; the given model predicts the reference targets to {rms * 1e6:.1f} um RMS"
         else:
             self.model = model
             r = self.thermal.result

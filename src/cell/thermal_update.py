@@ -16,10 +16,12 @@ import numpy as np
 
 from cell.config import CellConfig
 from robots import Arm
+from robots.thermal.compensate import compensated_T_base_tcp
 from robots.thermal.errors import ThermalError
 from robots.thermal.identify import IdentificationResult, identify
 from robots.thermal.model import ThermalModel, ThermalSpec
 from robots.thermal.observations import CellGeometry, Observations
+from robots.transforms import invert
 
 
 def sensor_spec(n_sensors: int, reference_c: float) -> ThermalSpec:
@@ -89,3 +91,14 @@ class ThermalUpdate:
             return None
         self.refusal = ""
         return self.result.model
+
+    def check(self, model: ThermalModel) -> float:
+        """RMS (m) of measured minus predicted target positions in the TCP frame, every row."""
+        targets = {r.id: np.asarray(r.position, float) for r in self.cell.reference_targets}
+        err = []
+        for _, target, q, temps, p_tcp in self.rows:
+            T_cell_tcp = self.arm.T_cell_base @ compensated_T_base_tcp(model, q, temps)
+            T_tcp_cell = invert(T_cell_tcp)
+            pred = T_tcp_cell[:3, :3] @ targets[target] + T_tcp_cell[:3, 3]
+            err.append(np.sum((p_tcp - pred) ** 2))
+        return float(np.sqrt(np.mean(err)))
