@@ -34,6 +34,9 @@ from scipy.optimize import least_squares
 from measure.errors import FitError
 
 CIRCLE_COSTS = ("orthogonal", "published")
+#: consensus tolerance of the robust start: max(0.5 % of the radius, 10 µm)
+RANSAC_TOL_FRAC = 0.005
+RANSAC_TOL_MIN_M = 10e-6
 
 
 @dataclass(frozen=True)
@@ -151,8 +154,8 @@ def ransac_circle(
     w: np.ndarray,
     r_guess: float,
     trials: int = 96,
-    tol_frac: float = 0.005,
-    tol_min_m: float = 10e-6,
+    tol_frac: float = RANSAC_TOL_FRAC,
+    tol_min_m: float = RANSAC_TOL_MIN_M,
     seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray, float, float]:
     """Best-supported circle through three points (support: points within
@@ -222,9 +225,9 @@ def fit_circle_3d(
     floor = min_reject_m / reject_sigma
     if robust:
         # the published start, refined; if a 3-point RANSAC circle has more support within
-        # 0.5 % of the radius (a dented or partly false contour), start from that instead
+        # max(0.5 % of the radius, 10 µm) (a dented or partly false contour), start from it
         c, n, r, *_ = _solve(pts, w, c, n, r, cost)
-        tol = max(0.005 * r, 10e-6)
+        tol = max(RANSAC_TOL_FRAC * r, RANSAC_TOL_MIN_M)
         own = float((w * (orthogonal_distance(pts, c, n, r) < tol)).sum() / w.sum())
         if own < 0.9:
             rc, rn, rr, support = ransac_circle(pts, w, r)

@@ -39,14 +39,15 @@ class HoleRegion:
 class EdgePoints:
     """Sub-pixel edge points (N, 2) in full-image pixels and their gradient strength.
 
-    ``blur_sigma_px`` is the edge's total blur (optics, smoothing and the Sobel kernel)
-    measured from the gradient profile across the edge: the median over the points of the
-    width of a Gaussian through the three gradient samples, projected onto the gradient.
+    ``width_px`` is, per point, the width of a Gaussian through the three gradient samples
+    across the edge (projected onto the gradient; inf where undefined); ``blur_sigma_px``
+    its median, the edge's total blur (optics, smoothing and the Sobel kernel).
     """
 
     points_px: np.ndarray
     strength: np.ndarray
     blur_sigma_px: float = 0.0
+    width_px: np.ndarray | None = None
 
 
 def hole_region(
@@ -126,31 +127,27 @@ def subpixel_edges(
     else:
         off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
     pts = np.stack([xs + off * sx + x0, ys + off * sy + y0], axis=1)[ok]
+    widths = _edge_widths(mag, gx, gy, xs[ok], ys[ok], sx[ok], sy[ok])
+    finite = widths[np.isfinite(widths)]
     return EdgePoints(
         points_px=pts.astype(np.float64),
         strength=mag[ys, xs][ok].astype(np.float64),
-        blur_sigma_px=_blur_sigma(mag, gx, gy, xs[ok], ys[ok], sx[ok], sy[ok]),
+        blur_sigma_px=float(np.median(finite)) if len(finite) else 0.0,
+        width_px=widths,
     )
 
 
-def _blur_sigma(mag, gx, gy, xs, ys, sx, sy) -> float:
-    """Median Gaussian width of the gradient profile across the edge (pixels)."""
-    if len(xs) == 0:
-        return 0.0
+def _edge_widths(mag, gx, gy, xs, ys, sx, sy) -> np.ndarray:
+    """Gaussian width (px) of the gradient profile across the edge at each point (inf: none)."""
     lg = [
         np.log(np.maximum(mag[ys + k * sy, xs + k * sx].astype(np.float64), 1e-12))
         for k in (-1, 0, 1)
     ]
     curv = lg[0] - 2.0 * lg[1] + lg[2]
-    ok = curv < 0
-    if not ok.any():
-        return 0.0
-    sigma_axis = np.sqrt(-1.0 / curv[ok])
-    g = np.hypot(gx[ys, xs], gy[ys, xs])[ok]
-    along = np.where(sx[ok] == 1, np.abs(gx[ys, xs][ok]), np.abs(gy[ys, xs][ok])) / np.maximum(
-        g, 1e-12
-    )
-    return float(np.median(sigma_axis * along))
+    g = np.maximum(np.hypot(gx[ys, xs], gy[ys, xs]).astype(np.float64), 1e-12)
+    along = np.where(sx == 1, np.abs(gx[ys, xs]), np.abs(gy[ys, xs])) / g
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(curv < 0, np.sqrt(-1.0 / curv) * along, np.inf)
 
 
 def _parabola(mag, xs, ys, sx, sy) -> tuple[np.ndarray, np.ndarray]:

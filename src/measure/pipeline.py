@@ -91,9 +91,10 @@ def _pick_pair(
 def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour, Rect, float]:
     region = hole_region(img, full, cand)
     edges = subpixel_edges(img, full, region, opts.edge_method, opts.smoothing_sigma_px)
+    pts = edges.points_px
     blur = edges.blur_sigma_px if opts.curvature_correction else 0.0
     contour = build_contour(
-        edges.points_px, region.centroid_px, opts.arc_step_px, opts.short_gap_px, blur_sigma_px=blur
+        pts, region.centroid_px, opts.arc_step_px, opts.short_gap_px, blur_sigma_px=blur
     )
     if contour is None:
         raise EdgeError(f"{which} image edges", len(edges.points_px), 12)
