@@ -50,8 +50,8 @@ class DemoOptions:
 
     warmup_speed: float = 1500.0
     run_speed: float = 10.0
-    reference_rounds: int = 4
-    reference_interval_s: float = 900.0
+    reference_rounds: int = 6
+    reference_interval_s: float = 600.0
     faults: FaultPlan = field(default_factory=FaultPlan)
     seed: int = 0
 
