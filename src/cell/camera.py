@@ -16,8 +16,10 @@ from typing import Protocol
 
 import numpy as np
 
+from cell.config import CellConfig
 from cell.errors import CellError
 from measure import StereoCalibration
+from measure.synth import standard_stereo
 
 
 @dataclass(frozen=True)
@@ -40,6 +42,13 @@ class CameraBackend(Protocol):
     def close(self) -> None:
         """Release the cameras."""
         ...
+
+
+def cell_stereo(cell: CellConfig) -> StereoCalibration:
+    """The cell's stereo calibration file, or the standard head (:func:`measure.synth.
+    standard_stereo`, the simulated head) when the cell names none."""
+    path = cell.calibration_path()
+    return StereoCalibration.load(path) if path is not None else standard_stereo()
 
 
 class CameraError(CellError):

@@ -32,7 +32,7 @@ def T_cell_tcp(
     return arm.T_cell_base @ compensated_T_base_tcp(model, q_rad, temps_c)
 
 
-def inspect(
+def inspect_hole(
     cell: CellConfig,
     arm: Arm,
     model: ThermalModel | None,

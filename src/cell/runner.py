@@ -21,7 +21,7 @@ import numpy as np
 from cell.camera import CameraBackend
 from cell.config import CellConfig
 from cell.errors import CellError
-from cell.inspect_hole import T_cell_tcp, inspect
+from cell.inspect_hole import T_cell_tcp, inspect_hole
 from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError, RequestRefusedError
@@ -304,7 +304,7 @@ class Runner:
         clock.lap("settle_s")
         pair = self.camera.capture()
         clock.lap("capture_s")
-        result, meas = inspect(self.cell, self.arm, self.model, self.camera.stereo,
+        result, meas = inspect_hole(self.cell, self.arm, self.model, self.camera.stereo,
                                self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
                                st.temperatures_c, st.time_s)  # fmt: skip
         clock.lap("inspect_s")

@@ -88,7 +88,8 @@ def test_estop_stops_the_run_and_resume_completes(small_cell: SmallCell, tmp_pat
         with Store.open(tmp_path) as store:
             assert store.stored_ids() == {small_cell.tour.hole_order[0]}
             assert store.run_info()["state"] == "fault"
-        ControllerClient(sim.url, FAST_LINK).__enter__().reset()  # the operator clears it
+        with ControllerClient(sim.url, FAST_LINK) as operator:
+            operator.reset()  # the fault is cleared at the cell
         result, stored, _ = _run(small_cell, tmp_path, sim, resume=True)
     assert result.skipped == [small_cell.tour.hole_order[0]]
     assert [r.hole_id for r in stored] == small_cell.tour.hole_order

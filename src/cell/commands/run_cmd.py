@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from cell.camera import NetworkCamera
+from cell.camera import NetworkCamera, cell_stereo
 from cell.commands.run_progress import RunBars
 from cell.config import load_cell
 from cell.errors import CellError
@@ -17,7 +17,6 @@ from cell.reference import plan_reference_tour
 from cell.report import format_summary, write_report
 from cell.run_setup import RunFiles, resume_run, start_run
 from cell.runner import RunFaultError, Runner, RunOptions
-from cell.sim.session import cell_stereo
 from planner import load_tour
 from robots.thermal.modelfile import load_model
 

@@ -8,20 +8,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from cell.camera import cell_stereo
 from cell.config import CellConfig
 from cell.sim.camera import SimCamera
 from cell.sim.controller import SimController
 from cell.sim.faults import FaultPlan
 from cell.sim.server import SimServer
 from cell.sim.world import SimWorld, WorldOptions
-from measure import StereoCalibration
-from measure.synth import RenderOptions, standard_stereo
-
-
-def cell_stereo(cell: CellConfig) -> StereoCalibration:
-    """The cell's stereo calibration file, or the standard head when the cell names none."""
-    path = cell.calibration_path()
-    return StereoCalibration.load(path) if path is not None else standard_stereo()
+from measure.synth import RenderOptions
 
 
 @dataclass
