@@ -1,47 +1,5 @@
-"""Shared fixtures of the cell tests: a small cell (three holes of the built-in frame, written to
-a file) and its planned tours, planned once per session."""
+"""Fixtures of the cell tests (defined in :mod:`cell_fixtures`)."""
 
-from __future__ import annotations
+from cell_fixtures import small_cell
 
-from dataclasses import dataclass
-from pathlib import Path
-
-import pytest
-import yaml
-
-from cell.config import CellConfig, builtin_cell_path, load_cell
-from cell.reference import plan_reference_tour
-from planner import Options, Tour, plan_tour
-from robots.thermal.drift import DriftSettings, WarmUp
-
-N_HOLES = 3
-
-
-@dataclass
-class SmallCell:
-    """A three-hole cell file, its tour (also as a file) and its reference tour."""
-
-    path: Path
-    cell: CellConfig
-    tour: Tour
-    tour_path: Path
-    reference: Tour
-
-
-@pytest.fixture(scope="session")
-def small_cell(tmp_path_factory: pytest.TempPathFactory) -> SmallCell:
-    root = tmp_path_factory.mktemp("small_cell")
-    data = yaml.safe_load(builtin_cell_path().read_text())
-    data["name"] = "small_frame"
-    data["part"]["holes"] = data["part"]["holes"][:N_HOLES]
-    path = root / "small.yaml"
-    path.write_text(yaml.safe_dump(data, sort_keys=False))
-    cell = load_cell(path)
-    tour = plan_tour(cell, Options(seed=1))
-    tour_path = tour.save(root / "tour.json")
-    return SmallCell(path, cell, tour, tour_path, plan_reference_tour(cell, Options(seed=1)))
-
-
-def steady_drift() -> DriftSettings:
-    """An arm that does not warm up and sensors without noise: runs repeat bit for bit."""
-    return DriftSettings.per_joint(("steel",) * 6, (WarmUp(0.0, 100.0),) * 6)
+__all__ = ["small_cell"]

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import rerun.chunk as rrc
-from conftest import SmallCell, steady_drift
+from cell_fixtures import SmallCell, steady_drift
 
 from cell.link.client import ControllerClient
 from cell.record import Recorder

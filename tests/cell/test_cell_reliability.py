@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from conftest import SmallCell, steady_drift
+from cell_fixtures import SmallCell, steady_drift
 
 from cell.link.client import ControllerClient, LinkOptions
 from cell.run_setup import start_run

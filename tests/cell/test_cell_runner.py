@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import SmallCell, steady_drift
+from cell_fixtures import SmallCell, steady_drift
 
 from cell.demo import truth_error
 from cell.link.client import ControllerClient, LinkOptions

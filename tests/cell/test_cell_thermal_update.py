@@ -4,7 +4,7 @@ check of a given model against the reference targets."""
 from __future__ import annotations
 
 import numpy as np
-from conftest import SmallCell
+from cell_fixtures import SmallCell
 
 from cell.thermal_update import ThermalUpdate, sensor_spec
 from robots.thermal.model import ThermalModel
