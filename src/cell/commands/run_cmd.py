@@ -4,18 +4,19 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from cell.camera import NetworkCamera, cell_stereo
 from cell.commands.run_progress import RunBars
-from cell.config import load_cell
+from cell.config import CellConfig, load_cell
 from cell.errors import CellError
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError
 from cell.record import Recorder
 from cell.reference import plan_reference_tour
 from cell.report import format_summary, write_report
-from cell.run_setup import RunFiles, resume_run, start_run
+from cell.run_setup import RunFiles, check_tour, resume_run, start_run
 from cell.runner import RunFaultError, Runner, RunOptions
 from planner import load_tour
 from robots.thermal.modelfile import load_model
@@ -56,20 +57,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=run_run)
 
 
-def _files(args: argparse.Namespace) -> RunFiles:
+def _prepare(args: argparse.Namespace) -> tuple[CellConfig, Callable[[], RunFiles]]:
+    """The cell, and how to open the run's store once controller and head answer. Every input
+    is checked here, before anything is connected or written."""
     if args.resume:
         if args.tour or args.cell:
             raise CellError("--resume takes the cell and tour from the run; give neither")
-        return resume_run(args.resume)
+        files = resume_run(args.resume)
+        return files.cell, lambda: files
     if not args.tour or not args.cell:
         raise CellError("give TOUR and --cell CELL (or --resume RUN_DIR)")
     cell = load_cell(args.cell)
     tour = load_tour(args.tour)
+    check_tour(tour, cell, args.tour)
     reference = (
         plan_reference_tour(cell) if cell.reference_targets and args.reference_rounds else None
     )
     out = Path(args.out) if args.out else Path("runs") / Path(args.tour).stem
-    return start_run(out, cell, tour, args.tour, args.port, reference)
+    return cell, lambda: start_run(out, cell, tour, args.tour, args.port, reference)
 
 
 def _rrd_path(run_dir: Path) -> Path:
@@ -86,20 +91,21 @@ def _ask_start() -> None:
 
 def run_run(args: argparse.Namespace) -> int:
     """Handler of ``holecell run``."""
-    files = _files(args)
-    run_dir = files.store.path.parent
+    cell, open_files = _prepare(args)
     model = load_model(args.thermal) if args.thermal else None
-    stored = len(files.store.stored_ids())
     client = ControllerClient(args.port)
-    camera = recorder = None
+    camera = recorder = files = None
     try:
         client.connect()
-        if client.identity.robot_model != files.cell.robot.model:
+        if client.identity.robot_model != cell.robot.model:
             raise CellError(
                 f"controller at {args.port} drives {client.identity.robot_model!r}, "
-                f"the cell has {files.cell.robot.model!r}"
+                f"the cell has {cell.robot.model!r}"
             )
-        camera = NetworkCamera(args.camera, cell_stereo(files.cell))
+        camera = NetworkCamera(args.camera, cell_stereo(cell))
+        files = open_files()
+        run_dir = files.store.path.parent
+        stored = len(files.store.stored_ids())
         options = RunOptions(
             settle_s=args.settle_s,
             reference_rounds=args.reference_rounds,
@@ -125,7 +131,8 @@ def run_run(args: argparse.Namespace) -> int:
             camera.close()
         if recorder is not None:
             recorder.close()
-        files.store.close()
+        if files is not None:
+            files.store.close()
     print(format_summary(write_report(run_dir)))
     print(f"run directory: {run_dir}")
     return 0
