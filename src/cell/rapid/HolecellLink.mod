@@ -182,6 +182,7 @@ MODULE HolecellLink
     IF ERRNO = ERR_DEV_MAXTIME THEN
       RETURN -1;
     ENDIF
+    RAISE;
   ENDFUNC
 
   PROC hcRxByte(num b)
@@ -256,6 +257,7 @@ MODULE HolecellLink
     crc := BitXOrDnum(hcCrcRaw(HC_CRC32_INIT, f, 3, n + 4), HC_CRC32_INIT);
     PackRawBytes crc, f, n + 7 \IntX:=UDINT;
     WriteRawBytes hcChan, f;
+    ClearRawBytes hcLastAnswer;
     CopyRawBytes f, 1, hcLastAnswer, 1;
   ENDPROC
 
@@ -517,7 +519,7 @@ MODULE HolecellLink
       hcTargetStop := -1;
       hcState := ST_IN_POSITION;
     ELSE
-      MoveAbsJ jt \NoEOffs \Conc, v1000 \T:=HC_ROW_STEP * hcDt, z5, tool0;
+      MoveAbsJ \Conc, jt \NoEOffs, v1000 \T:=HC_ROW_STEP * hcDt, z5, tool0;
       hcPos := next;
     ENDIF
   ENDPROC
