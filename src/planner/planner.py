@@ -41,10 +41,10 @@ ProgressCallback = Callable[[str, int, int], None]
 #: a replacement sequencer: (home q, candidates per hole, limits) -> SequenceResult
 Sequencer = Callable[[NDArray[np.float64], list[HoleCandidates], JointLimits], SequenceResult]
 STAGES = ("viewpoints", "sequence", "paths", "timing")
-#: share of the sequencing budget and effort of each re-sequencing after detours were measured
+#: time cap of each repair search after costs changed, as a share of the sequencing budget
 REFINE_SHARE = 0.15
 #: at most this many lazy re-sequencing rounds (and at most the sequencing budget in time)
-LAZY_ROUNDS = 12
+LAZY_ROUNDS = 20
 #: lazy edge checks are this many times coarser than the set motion resolution
 LAZY_COARSENESS = 3.0
 #: estimated duration of a colliding straight edge until its detour is measured: factor, extra s
@@ -189,7 +189,7 @@ class TourPlanner:
                 break
             seqr.learn(penalties)
             budget = o.budget_s(n_holes) * REFINE_SHARE
-            res = seqr.solve(budget, o.seed + 100 + k, o.effort * REFINE_SHARE, warm=res.nodes)
+            res = seqr.solve(budget, o.seed + 100 + k, o.effort, warm=res.nodes, repair=True)
         return res
 
     def _sequence_and_paths(
@@ -235,7 +235,7 @@ class TourPlanner:
             measured_pairs.update((v, u) for u, v in measured)
             seqr.learn(measured)
             budget = o.budget_s(len(cands)) * REFINE_SHARE
-            new = seqr.solve(budget, o.seed + rounds, o.effort * REFINE_SHARE, warm=res.nodes)
+            new = seqr.solve(budget, o.seed + rounds, o.effort, warm=res.nodes, repair=True)
             timings["sequence"] += time.perf_counter() - t
             if new.nodes == res.nodes:
                 return route, segments, new, rounds

@@ -225,14 +225,20 @@ class GtspSequencer:
         seed: int,
         effort: float = 1.0,
         warm: Sequence[int] | None = None,
+        repair: bool = False,
     ) -> SequenceResult:
-        """Search a tour; ``warm`` (visited nodes) seeds the LNS instead of its greedy start."""
+        """Search a tour; ``warm`` (visited nodes) seeds the LNS instead of its greedy start.
+
+        ``repair`` (with ``warm``): a short search that mends a tour after some of its
+        costs changed (work 20 + n/10 iterations, scaled by ``effort``).
+        """
         started = time.perf_counter()
         n = len(self.candidates)
         if self.method == "lns":
+            short = repair and warm is not None
             settings = LnsSettings(
-                max_iterations=int(effort * (200 + 4 * n)),
-                patience=int(effort * (50 + n)),
+                max_iterations=int(effort * ((20 + n // 10) if short else (200 + 4 * n))),
+                patience=int(effort * ((10 + n // 20) if short else (50 + n))),
                 time_limit_s=time_budget_s,
             )
             start = None if warm is None else [int(self.owner[v]) for v in warm]
