@@ -18,7 +18,7 @@ from cell.config import CellConfig, parse_cell
 from cell.errors import CellError
 from cell.runner import stop_rows
 from cell.store import Store
-from planner import Tour
+from planner import Tour, TourCellMismatchError, check_tour_for_cell
 from planner.planner import cell_sha256
 from planner.tour import tour_from_dict
 from robots.models import JOINT_NAMES
@@ -36,16 +36,17 @@ class TourMismatchError(CellError):
 
 
 def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False) -> None:
-    """Refuse a tour not made for ``cell``. Reference tours are checked for the robot only."""
-    if not reference:
-        if tour.cell_name != cell.name:
-            raise TourMismatchError(where, "cell.name", tour.cell_name, cell.name)
-        if tour.cell_sha256 != cell_sha256(cell):
-            raise TourMismatchError(
-                where, "cell.sha256", tour.cell_sha256[:12], cell_sha256(cell)[:12]
-            )
-    if tour.robot_model != cell.robot.model:
-        raise TourMismatchError(where, "robot.model", tour.robot_model, cell.robot.model)
+    """Refuse a tour not made for ``cell`` (:func:`planner.check_tour_for_cell`: robot model, cell
+    name, SHA-256 of the cell file text; here also joint names, trajectory shape, stops on the
+    trajectory, known holes). Reference tours are checked for the robot only."""
+    if reference:
+        if tour.robot_model != cell.robot.model:
+            raise TourMismatchError(where, "robot model", tour.robot_model, cell.robot.model)
+    else:
+        try:
+            check_tour_for_cell(tour, cell)
+        except TourCellMismatchError as exc:
+            raise TourMismatchError(where, exc.field, exc.tour_value, exc.cell_value) from exc
     if tuple(tour.joint_names) != JOINT_NAMES:
         raise TourMismatchError(where, "robot.joint_names", tour.joint_names, JOINT_NAMES)
     traj = np.asarray(tour.trajectory)
@@ -55,7 +56,7 @@ def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False
         known = {h.id for h in cell.part.holes}
         unknown = [s.hole_id for s in tour.stops if s.hole_id not in known]
         if unknown:
-            raise TourMismatchError(where, "stops.hole_id", unknown[:5], "no such holes")
+            raise CellError(f"{where}: stops.hole_id: holes the cell does not have: {unknown[:5]}")
     stop_rows(tour)
 
 
