@@ -43,8 +43,10 @@ Sequencer = Callable[[NDArray[np.float64], list[HoleCandidates], JointLimits], S
 STAGES = ("viewpoints", "sequence", "paths", "timing")
 #: time cap of each repair search after costs changed, as a share of the sequencing budget
 REFINE_SHARE = 0.15
-#: at most this many lazy re-sequencing rounds (and at most the sequencing budget in time)
+#: at most this many lazy re-sequencing rounds ...
 LAZY_ROUNDS = 20
+#: ... and at most this share of the sequencing budget in time
+LAZY_BUDGET_SHARE = 0.5
 #: lazy edge checks are this many times coarser than the set motion resolution
 LAZY_COARSENESS = 3.0
 #: estimated duration of a colliding straight edge until its detour is measured: factor, extra s
@@ -173,7 +175,7 @@ class TourPlanner:
         coarse = checker.coarser(LAZY_COARSENESS)
         started = time.perf_counter()
         for k in range(LAZY_ROUNDS):
-            if time.perf_counter() - started > o.budget_s(n_holes):
+            if time.perf_counter() - started > LAZY_BUDGET_SHARE * o.budget_s(n_holes):
                 break
             path = [0, *(res.nodes or []), 0]
             penalties = {}
