@@ -25,12 +25,11 @@ from robots.transforms import invert
 
 
 def sensor_spec(n_sensors: int, reference_c: float) -> ThermalSpec:
-    """The sensor-to-link map for ``n_sensors`` readings with every reference at ``reference_c``."""
-    if n_sensors == 6:
-        names, links = tuple(f"j{i}" for i in range(1, 7)), tuple(range(6))
-    else:
-        names, links = tuple(f"t{i}" for i in range(1, n_sensors + 1)), (0,) * 6
-    return ThermalSpec(names, links, (reference_c,) * n_sensors)
+    """The sensor-to-link map (:meth:`ThermalSpec.mapped`) for ``n_sensors`` readings, every
+    reference at ``reference_c``: six sensors ``j1..j6`` one per link, or one shared sensor."""
+    names = tuple(f"j{i}" for i in range(1, 7)) if n_sensors == 6 else (
+        tuple(f"t{i}" for i in range(1, n_sensors + 1)))  # fmt: skip
+    return ThermalSpec.mapped(names, (reference_c,) * n_sensors)
 
 
 @dataclass
@@ -75,14 +74,14 @@ class ThermalUpdate:
         if not self.rows:
             self.refusal = "no reference observations"
             return None
-        obs = self.observations()
-        geometry = CellGeometry(
-            self.arm.T_cell_base,
-            self.arm.T_tool0_tcp,
-            {r.id: np.asarray(r.position, float) for r in self.cell.reference_targets},
-        )
-        spec = sensor_spec(obs.temps_degC.shape[1], self.reference_c)
         try:
+            obs = self.observations()
+            geometry = CellGeometry(
+                self.arm.T_cell_base,
+                self.arm.T_tool0_tcp,
+                {r.id: np.asarray(r.position, float) for r in self.cell.reference_targets},
+            )
+            spec = sensor_spec(obs.temps_degC.shape[1], self.reference_c)
             self.result = identify(
                 obs, geometry, self.arm.dh, spec, robot_model=self.cell.robot.model
             )
