@@ -4,8 +4,8 @@ Each measured reference target gives one observation row (time, target, joints, 
 target position in the TCP frame), the format of :mod:`robots.thermal.observations`. After a
 reference round the runner identifies a model from every row so far with
 :func:`robots.thermal.identify.identify`; what the data cannot determine is refused there and
-reported here. Sensors: six readings are taken as one sensor per joint (link i -> sensor i);
-any other count as sensors shared by every link (link -> sensor 0).
+reported here. Sensors: six readings are taken as one sensor per joint (link i -> sensor i),
+one reading as a sensor shared by every link; other counts are refused.
 """
 
 from __future__ import annotations
