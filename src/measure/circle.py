@@ -192,6 +192,7 @@ def fit_circle_3d(
     reject_sigma: float = 3.5,
     min_reject_m: float = 1e-6,
     toward: np.ndarray | None = None,
+    start: Circle3D | None = None,
 ) -> Circle3D:
     """Fit a circle to 3-D points (N, 3, metres) by LM; robust to outliers (see module doc).
 
@@ -204,6 +205,9 @@ def fit_circle_3d(
         min_reject_m: never reject points closer than this (metres).
         toward: if given, the normal is oriented to point toward this point (e.g. the
             camera centre, the origin of the camera frame); otherwise toward the origin.
+        start: a circle known to be near the answer (e.g. a fit to a superset of the
+            points); the robust start (RANSAC, reweighting) is then skipped and the
+            rejection begins from it.
 
     Returns:
         :class:`Circle3D`. Raises :class:`FitError` for fewer than 6 usable points or a
@@ -221,9 +225,12 @@ def fit_circle_3d(
     if usable.sum() < 6:
         raise FitError(f"only {int(usable.sum())} usable points, at least 6 needed")
     pts, w = pts_all[usable], w_all[usable]
-    c, n, r = initial_circle(pts, w)
+    if start is not None:
+        c, n, r = np.asarray(start.center, float), np.asarray(start.normal, float), start.radius
+    else:
+        c, n, r = initial_circle(pts, w)
     floor = min_reject_m / reject_sigma
-    if robust:
+    if robust and start is None:
         # the published start, refined; if a 3-point RANSAC circle has more support within
         # max(0.5 % of the radius, 10 µm) (a dented or partly false contour), start from it
         c, n, r, *_ = _solve(pts, w, c, n, r, cost)

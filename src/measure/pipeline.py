@@ -26,6 +26,7 @@ from measure.errors import (
     ImageError,
 )
 from measure.match import match_contours
+from measure.nearside import fit_with_near_side_check
 from measure.result import HoleMeasurement, MeasureOptions
 from measure.triangulate import triangulate
 
@@ -172,7 +173,13 @@ def measure_hole(
         raise EdgeError("stereo matching", int((m.weight > 0).sum()), 12)
 
     t3 = time.perf_counter()
-    circ = fit_circle_3d(pts, m.weight, cost=opts.circle_cost, robust=opts.robust)
+    if opts.robust and opts.near_side_max_angle_deg is not None:
+        cams = np.stack([np.zeros(3), stereo.right_center_in_left])
+        circ, _ = fit_with_near_side_check(
+            pts, m.weight, cams, opts.near_side_max_angle_deg, cost=opts.circle_cost
+        )
+    else:
+        circ = fit_circle_3d(pts, m.weight, cost=opts.circle_cost, robust=opts.robust)
     t["fit"] = time.perf_counter() - t3
     if expected_diameter_m is not None:
         d = 2 * circ.radius

@@ -28,6 +28,9 @@ class MeasureOptions:
         min_epipolar_angle_deg: drop contour samples whose tangent is closer than this to the
             epipolar direction.
         robust: robust circle fit with rejection (see :func:`measure.fit_circle_3d`).
+        near_side_max_angle_deg: with ``robust``, edge points a camera sees over the rim
+            at more than this angle to the hole axis are kept only where they agree with a
+            circle fitted to the others (see :mod:`measure.nearside`); ``None`` disables.
         size_tolerance: relative diameter deviation from ``expected_diameter_m`` that is an error.
         suspect_fraction: status ``"suspect"`` when more than this fraction of the contour
             was filled or rejected.
@@ -42,6 +45,7 @@ class MeasureOptions:
     use_long_fills: bool = False
     min_epipolar_angle_deg: float = 20.0
     robust: bool = True
+    near_side_max_angle_deg: float | None = 25.0
     size_tolerance: float = 0.2
     suspect_fraction: float = 0.3
 
