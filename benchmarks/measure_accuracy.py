@@ -7,7 +7,8 @@ centre within ±2 mm of the meeting point; 8-bit images, read noise σ = 2 gray 
 optics blur, textured surface, vignetting. Each scene is seeded; truth is exact.
 
 Four methods on the same images:
-- default: Devernay sub-pixel Canny, curvature correction, orthogonal-distance LM fit;
+- default: Devernay sub-pixel Canny, curvature correction, orthogonal-distance LM fit
+  with outlier rejection and the near-side check (measure.nearside);
 - linear: the same but the published sub-pixel step (linear interpolation of gray values);
 - published: linear interpolation, no curvature correction, the published (mixed-unit)
   cost, long gaps filled and used;
