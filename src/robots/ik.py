@@ -106,28 +106,30 @@ def _arm_solutions(g: _Geometry, p_w: Array) -> tuple[list[tuple[float, float, f
     return out, "out of reach"
 
 
-def _wrist_solutions(R_0_3: Array, R_target: Array) -> list[tuple[float, float, float, int]]:
-    """Joint 4-6 solutions ``(q4, q5, q6, flip)``; empty when the wrist is singular."""
-    M = R_0_3.T @ R_target
-    s5_abs = math.hypot(M[0, 2], M[1, 2])
+def _wrist_solutions(
+    q1: float, q23: float, R: list[list[float]]
+) -> list[tuple[float, float, float, int]]:
+    """Joint 4-6 solutions ``(q4, q5, q6, flip)``; empty when the wrist is singular.
+
+    ``M = R_0_3^T R`` with ``R_0_3 = Rz(q1) Ry(q2 + q3) [[0,0,1],[0,-1,0],[1,0,0]]`` (the
+    orientation of D-H frame 3) and ``R`` the target orientation, as nested lists. Only the five
+    entries of ``M`` that the angles need are formed, in plain floats (this is the hot loop).
+    """
+    c1, s1, c23, s23 = math.cos(q1), math.sin(q1), math.cos(q23), math.sin(q23)
+    x0, x1, x2 = c1 * s23, s1 * s23, c23  # column 0 of R_0_3
+    z0, z1, z2 = c1 * c23, s1 * c23, -s23  # column 2 of R_0_3
+    m02 = x0 * R[0][2] + x1 * R[1][2] + x2 * R[2][2]
+    m12 = s1 * R[0][2] - c1 * R[1][2]  # column 1 of R_0_3 is (s1, -c1, 0)
+    m22 = z0 * R[0][2] + z1 * R[1][2] + z2 * R[2][2]
+    m20 = z0 * R[0][0] + z1 * R[1][0] + z2 * R[2][0]
+    m21 = z0 * R[0][1] + z1 * R[1][1] + z2 * R[2][1]
+    s5_abs = math.hypot(m02, m12)
     if s5_abs < WRIST_SINGULAR_TOL:
         return []
-    q5 = math.atan2(s5_abs, M[2, 2])
-    q4 = math.atan2(-M[1, 2], -M[0, 2])
-    q6 = math.atan2(-M[2, 1], M[2, 0]) - math.pi
+    q5 = math.atan2(s5_abs, m22)
+    q4 = math.atan2(-m12, -m02)
+    q6 = math.atan2(-m21, m20) - math.pi
     return [(q4, q5, q6, 0), (q4 + math.pi, -q5, q6 + math.pi, 1)]
-
-
-def _R_0_3(q1: float, q23: float) -> Array:
-    """Orientation of D-H frame 3: ``Rz(q1) @ Ry(q2 + q3) @ [[0,0,1],[0,-1,0],[1,0,0]]``."""
-    c1, s1, c23, s23 = math.cos(q1), math.sin(q1), math.cos(q23), math.sin(q23)
-    return np.array(
-        [
-            [c1 * s23, s1, c1 * c23],
-            [s1 * s23, -c1, s1 * c23],
-            [c23, 0.0, -s23],
-        ]
-    )
 
 
 def solve_ik(table: DHTable, T_base_tool0: Array, lower: Array, upper: Array) -> IKResult:
@@ -139,12 +141,13 @@ def solve_ik(table: DHTable, T_base_tool0: Array, lower: Array, upper: Array) ->
     R = T_base_tool0[:3, :3]
     p_w = T_base_tool0[:3, 3] - g.d6 * R[:, 2]
     arm, arm_reason = _arm_solutions(g, p_w)
+    R_list = R.tolist()
     if not arm:
         return _empty(arm_reason, 0)
     raw: list[tuple[float, ...]] = []
     branches: list[int] = []
     for q1, q2, q3, branch in arm:
-        for q4, q5, q6, flip in _wrist_solutions(_R_0_3(q1, q2 + q3), R):
+        for q4, q5, q6, flip in _wrist_solutions(q1, q2 + q3, R_list):
             raw.append((q1, q2, q3, q4, q5, q6))
             branches.append(branch + flip)
     if not raw:

@@ -111,6 +111,7 @@ def test_out_of_reach_and_singular_wrist() -> None:
     assert result.n_branches == 6
     assert np.abs(np.sin(result.solutions[:, 4])).min() > 1e-6
     assert np.abs(result.solutions[:, :3] - q[:3]).max(axis=1).min() > 1e-3
-    assert _wrist_solutions(np.eye(3), np.eye(3)) == []
+    # J1 = 0, J2 + J3 = pi/2: the forearm points down, so a tool0 facing down is wrist-singular
+    assert _wrist_solutions(0.0, np.pi / 2, [[1, 0, 0], [0, -1, 0], [0, 0, -1]]) == []
     above = make_transform(Rotation.from_euler("y", np.pi).as_matrix(), [0.0, 0.0, 1.5])
     assert arm.ik(above).reason == "shoulder singular"
