@@ -85,8 +85,14 @@ def link_transforms(table: DHTable, q: ArrayLike) -> Array:
     theta = np.asarray(q, dtype=float) + np.asarray(table.theta_offset_rad)
     ct, st = np.cos(theta), np.sin(theta)
     T = np.empty((*theta.shape, 4, 4))
-    T[..., 0, :] = np.stack((ct, -st * ca, st * sa, a * ct), axis=-1)
-    T[..., 1, :] = np.stack((st, ct * ca, -ct * sa, a * st), axis=-1)
+    T[..., 0, 0] = ct
+    T[..., 0, 1] = -st * ca
+    T[..., 0, 2] = st * sa
+    T[..., 0, 3] = a * ct
+    T[..., 1, 0] = st
+    T[..., 1, 1] = ct * ca
+    T[..., 1, 2] = -ct * sa
+    T[..., 1, 3] = a * st
     T[..., 2:, :] = rows
     return T
 
@@ -94,8 +100,8 @@ def link_transforms(table: DHTable, q: ArrayLike) -> Array:
 def fk_dh(table: DHTable, q: ArrayLike) -> Array:
     """``T_base_tool0`` from the D-H table; ``q`` (6,) or (N, 6) gives (4, 4) or (N, 4, 4)."""
     T_links = link_transforms(table, q)
-    T = T_links[..., 0, :, :]
-    for i in range(1, 6):
+    T = T_links[..., 0, :, :] @ T_links[..., 1, :, :]
+    for i in range(2, 6):
         T = T @ T_links[..., i, :, :]
     return T
 

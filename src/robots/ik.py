@@ -169,24 +169,27 @@ def expand_within_limits(
 
     Rows with a joint that has no such value are dropped. Returns ``(solutions, branches)``.
     """
-    lower = np.asarray(lower, dtype=float)
-    upper = np.asarray(upper, dtype=float)
-    grid = _shift_grid(tuple(lower.tolist()), tuple(upper.tolist()))
-    wrapped = (Q + np.pi) % TWO_PI - np.pi
-    cand = wrapped[:, None, :] + grid[None, :, :]
-    inside = np.all((cand >= lower - 1e-12) & (cand <= upper + 1e-12), axis=2)
+    grid, lo, hi = _shift_grid(
+        tuple(np.asarray(lower, float).tolist()), tuple(np.asarray(upper, float).tolist())
+    )
+    cand = ((Q + math.pi) % TWO_PI - math.pi)[:, None, :] + grid
+    inside = ((cand >= lo) & (cand <= hi)).all(axis=2)
     rows, cols = np.nonzero(inside)
     return np.clip(cand[rows, cols], lower, upper), branches[rows]
 
 
 @lru_cache(maxsize=16)
-def _shift_grid(lower: tuple[float, ...], upper: tuple[float, ...]) -> Array:
-    """Every combination of per-joint shifts ``2*pi*k`` taking a value in [-pi, pi) into limits."""
+def _shift_grid(lower: tuple[float, ...], upper: tuple[float, ...]) -> tuple[Array, Array, Array]:
+    """Every combination of per-joint shifts ``2*pi*k`` taking a value in [-pi, pi) into limits.
+
+    Also returns the limits widened by 1e-12 rad, so values on a limit are kept.
+    """
     per_joint = []
     for lo, hi in zip(lower, upper, strict=True):
         ks = [k for k in range(-3, 4) if -math.pi + TWO_PI * k <= hi and math.pi + TWO_PI * k >= lo]
         per_joint.append([TWO_PI * k for k in ks])
-    return np.array(list(product(*per_joint)), dtype=float).reshape(-1, len(lower))
+    grid = np.array(list(product(*per_joint)), dtype=float).reshape(-1, len(lower))
+    return grid, np.array(lower) - 1e-12, np.array(upper) + 1e-12
 
 
 def _verified(table: DHTable, Q: Array, T_target: Array) -> NDArray[np.bool_]:
