@@ -21,7 +21,7 @@ from robots import MODELS, Arm
 
 
 def _time_per_call(
-    fn: Callable[[np.ndarray], object], inputs: np.ndarray, repeats: int = 3
+    fn: Callable[[np.ndarray], object], inputs: np.ndarray, repeats: int = 5
 ) -> float:
     """Best-of-``repeats`` mean CPU time per call (s) of this process.
 
