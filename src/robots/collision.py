@@ -22,21 +22,13 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from robots.models import LINK_NAMES
 from robots.shapes import Shape
 
 Array = NDArray[np.float64]
 
 #: bodies of the arm chain, in order; adjacent ones are never checked against each other
-CHAIN_BODIES: tuple[str, ...] = (
-    "base_link",
-    "link_1",
-    "link_2",
-    "link_3",
-    "link_4",
-    "link_5",
-    "link_6",
-    "tool",
-)
+CHAIN_BODIES: tuple[str, ...] = (*LINK_NAMES, "tool")
 
 
 @dataclass(frozen=True)

@@ -69,22 +69,19 @@ def dh_table(spec: ArmSpec | str) -> DHTable:
 
 
 @lru_cache(maxsize=64)
-def _constant_rows(table: DHTable) -> tuple[Array, Array, Array, Array]:
-    """``(a, cos alpha, sin alpha, rows 2-3 of every link transform)`` of a table."""
-    a, d, alpha, _ = table.arrays()
+def _constant_rows(table: DHTable) -> tuple[Array, Array, Array, Array, Array]:
+    """``(a, theta offset, cos alpha, sin alpha, rows 2-3 of every link transform)`` of a table."""
+    a, d, alpha, offset = table.arrays()
     ca, sa = np.cos(alpha), np.sin(alpha)
     rows = np.zeros((6, 2, 4))
     rows[:, 0, 1], rows[:, 0, 2], rows[:, 0, 3] = sa, ca, d
     rows[:, 1, 3] = 1.0
-    return a, ca, sa, rows
+    return a, offset, ca, sa, rows
 
 
-def link_transforms(table: DHTable, q: ArrayLike) -> Array:
-    """Per-link transforms ``T_{i-1,i}``, shape ``(..., 6, 4, 4)``, for joints ``q`` (..., 6)."""
-    a, ca, sa, rows = _constant_rows(table)
-    theta = np.asarray(q, dtype=float) + np.asarray(table.theta_offset_rad)
+def _rotating_rows(T: Array, theta: Array, a: ArrayLike, ca: Array, sa: Array) -> None:
+    """Fill rows 0-1 of link transforms ``T`` (..., 6, 4, 4), the part that turns with theta."""
     ct, st = np.cos(theta), np.sin(theta)
-    T = np.empty((*theta.shape, 4, 4))
     T[..., 0, 0] = ct
     T[..., 0, 1] = -st * ca
     T[..., 0, 2] = st * sa
@@ -93,17 +90,55 @@ def link_transforms(table: DHTable, q: ArrayLike) -> Array:
     T[..., 1, 1] = ct * ca
     T[..., 1, 2] = -ct * sa
     T[..., 1, 3] = a * st
+
+
+def link_transforms(table: DHTable, q: ArrayLike) -> Array:
+    """Per-link transforms ``T_{i-1,i}``, shape ``(..., 6, 4, 4)``, for joints ``q`` (..., 6)."""
+    a, offset, ca, sa, rows = _constant_rows(table)
+    theta = np.asarray(q, dtype=float) + offset
+    T = np.empty((*theta.shape, 4, 4))
+    _rotating_rows(T, theta, a, ca, sa)
     T[..., 2:, :] = rows
+    return T
+
+
+def link_transforms_arrays(
+    a: ArrayLike, d: ArrayLike, alpha: ArrayLike, theta_offset: ArrayLike, q: ArrayLike
+) -> Array:
+    """Per-link transforms ``(..., 6, 4, 4)`` for D-H arrays that may differ per row.
+
+    ``a``, ``d``, ``theta_offset`` (m, m, rad) broadcast against ``q`` (..., 6); ``alpha`` is (6,).
+    """
+    theta = np.asarray(q, dtype=float) + theta_offset
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    shape = np.broadcast_shapes(theta.shape, np.shape(a), np.shape(d))
+    T = np.zeros((*shape, 4, 4))
+    _rotating_rows(T, np.broadcast_to(theta, shape), a, ca, sa)
+    T[..., 2, 1] = sa
+    T[..., 2, 2] = ca
+    T[..., 2, 3] = d
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def chain(T_links: Array) -> Array:
+    """Product ``T_01 @ T_12 @ ... @ T_56`` of per-link transforms (..., 6, 4, 4)."""
+    T = T_links[..., 0, :, :] @ T_links[..., 1, :, :]
+    for i in range(2, 6):
+        T = T @ T_links[..., i, :, :]
     return T
 
 
 def fk_dh(table: DHTable, q: ArrayLike) -> Array:
     """``T_base_tool0`` from the D-H table; ``q`` (6,) or (N, 6) gives (4, 4) or (N, 4, 4)."""
-    T_links = link_transforms(table, q)
-    T = T_links[..., 0, :, :] @ T_links[..., 1, :, :]
-    for i in range(2, 6):
-        T = T @ T_links[..., i, :, :]
-    return T
+    return chain(link_transforms(table, q))
+
+
+def fk_dh_arrays(
+    a: ArrayLike, d: ArrayLike, alpha: ArrayLike, theta_offset: ArrayLike, q: ArrayLike
+) -> Array:
+    """``T_base_tool0`` (..., 4, 4) for D-H arrays that may differ per row (see ``fk_dh``)."""
+    return chain(link_transforms_arrays(a, d, alpha, theta_offset, q))
 
 
 def fk_dh_frames(table: DHTable, q: ArrayLike) -> Array:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from robots.dh import DHTable
+from robots.dh import DHTable, fk_dh_arrays
 from robots.thermal.errors import ThermalSpecError
 
 Array = NDArray[np.float64]
@@ -153,27 +153,7 @@ def drifted_arrays(
 
 def fk_rows(a: Array, d: Array, alpha: Array, theta_offset: Array, q: ArrayLike) -> Array:
     """``T_base_tool0`` (..., 4, 4) for D-H arrays that may differ per row (as ``fk_dh``)."""
-    theta = np.asarray(q, dtype=float) + theta_offset
-    ct, st = np.cos(theta), np.sin(theta)
-    ca, sa = np.cos(alpha), np.sin(alpha)
-    shape = np.broadcast_shapes(theta.shape, np.shape(a), np.shape(d))
-    L = np.zeros((*shape, 4, 4))
-    L[..., 0, 0] = ct
-    L[..., 0, 1] = -st * ca
-    L[..., 0, 2] = st * sa
-    L[..., 0, 3] = a * ct
-    L[..., 1, 0] = st
-    L[..., 1, 1] = ct * ca
-    L[..., 1, 2] = -ct * sa
-    L[..., 1, 3] = a * st
-    L[..., 2, 1] = sa
-    L[..., 2, 2] = ca
-    L[..., 2, 3] = d
-    L[..., 3, 3] = 1.0
-    T = L[..., 0, :, :]
-    for i in range(1, N_LINKS):
-        T = T @ L[..., i, :, :]
-    return T
+    return fk_dh_arrays(a, d, alpha, theta_offset, q)
 
 
 def coefficient_vectors(coefficients: Mapping[str, float]) -> tuple[Array, Array]:
