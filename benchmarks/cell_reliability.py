@@ -101,7 +101,7 @@ def faulty_runs(cell, tour, root: Path, seeds: list[int]) -> None:
         ids = [r.hole_id for r in stored]
         once = ids == tour.hole_order
         rows.append([seed, len(tour.stops), len(stored), "yes" if once else "NO",
-                     sum(r.measured for r in stored), sum(r.status == "fail" for r in stored),
+                     sum(r.measured for r in stored), sum(r.passed is False for r in stored),
                      srv.dropped, srv.corrupted,
                      srv.disconnects, result.link["requests"], result.link["retransmits"],
                      result.link["reconnects"],

@@ -78,6 +78,7 @@ def inspect_hole(
     status = "suspect" if meas.status == "suspect" else ("ok" if ok else "fail")
     result = HoleResult(
         status=status,
+        passed=ok,
         center_part_m=tuple(float(v) for v in center),
         normal_part=tuple(float(v) for v in normal),
         diameter_m=float(meas.diameter_m),

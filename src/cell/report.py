@@ -42,7 +42,8 @@ def summary(store: Store) -> dict[str, Any]:
         "holes_stored": len(results),
         "holes_measured": len(measured),
         "holes_missing": sum(r.status == "missing" for r in results),
-        "holes_failed": sum(r.status == "fail" for r in results),
+        "holes_failed": sum(r.passed is False for r in results),
+        "holes_suspect": sum(r.status == "suspect" for r in results),
         "holes_not_reached": len(planned) - len(results),
         "worst_position_deviation_m": worst.position_deviation_m if worst else None,
         "worst_hole": worst.hole_id if worst else None,
@@ -68,7 +69,7 @@ def _row(r: HoleResult) -> dict[str, Any]:
         "diameter_m": r.diameter_m,
         "diameter_deviation_m": r.diameter_deviation_m,
         "tolerance_m": r.tolerance_m,
-        "pass": None if not r.measured else r.status != "fail",
+        "pass": r.passed,
         "u_center_m": r.u_center_m,
         "u_diameter_m": r.u_diameter_m,
         "reason": r.reason,
@@ -101,7 +102,8 @@ def format_summary(summ: dict[str, Any]) -> str:
         f"cell            {summ['cell']} ({summ['robot_model']})",
         f"run state       {summ['state']}",
         f"holes           {summ['holes_measured']} measured, {summ['holes_missing']} missing, "
-        f"{summ['holes_failed']} out of tolerance, {summ['holes_not_reached']} not reached "
+        f"{summ['holes_failed']} out of tolerance, {summ['holes_suspect']} suspect, "
+        f"{summ['holes_not_reached']} not reached "
         f"(of {summ['holes_planned']} planned)",
     ]
     if worst is not None:

@@ -4,7 +4,9 @@ Frames and units: ``*_part_m`` in the part frame (m); ``normal_part`` unit axis 
 surface; deviations in m; ``q_rad`` joints at capture (rad); ``temperatures_c`` sensor readings
 (degC); times in s. ``status`` is ``"ok"`` (measured, within tolerance or no tolerance),
 ``"fail"`` (measured, out of tolerance), ``"suspect"`` (measured, but the measurement flags much
-filled or rejected edge) or ``"missing"`` (no hole where one should be; no measured values).
+filled or rejected edge: a quality flag, whatever the deviations) or ``"missing"`` (no hole where
+one should be; no measured values). ``passed`` is the verdict against the tolerance from the
+deviations alone (True / False), None when the hole was not measured; a suspect hole keeps it.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ class HoleResult:
     sim_time_s: float = 0.0
     measure_time_s: float = 0.0
     reason: str = ""
+    passed: bool | None = None
     extra: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

@@ -219,6 +219,8 @@ class Store:
                 if d.get(key) is not None:
                     d[key] = tuple(d[key])
             d["temperatures_c"] = tuple(d["temperatures_c"])
+            if "passed" not in d:  # stored before the verdict had its own field
+                d["passed"] = None if d.get("center_part_m") is None else d["status"] != "fail"
             out.append(HoleResult(**d))
         return out
 
