@@ -39,8 +39,10 @@ def _inspect(sc: SmallCell, monkeypatch, status: str, offset_m: float) -> HoleRe
     return result
 
 
-@pytest.mark.parametrize(("status", "offset_m", "passed"),
-                         [("suspect", 1e-3, False), ("suspect", 0.0, True), ("ok", 1e-3, False)])  # fmt: skip
+CASES = [("suspect", 1e-3, False), ("suspect", 0.0, True), ("ok", 1e-3, False)]
+
+
+@pytest.mark.parametrize(("status", "offset_m", "passed"), CASES)
 def test_verdict_comes_from_deviations(small_cell, monkeypatch, status, offset_m, passed) -> None:
     r = _inspect(small_cell, monkeypatch, status, offset_m)
     assert r.passed is passed
