@@ -32,7 +32,7 @@ Positive = Annotated[float, Field(gt=0)]
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class Pose(_Strict):
@@ -50,8 +50,8 @@ class Pose(_Strict):
         return q
 
     def model_post_init(self, __context: Any) -> None:
-        if self.rpy is not None and self.quat_xyzw is not None:
-            raise ValueError("give either rpy or quat_xyzw, not both")
+        if (self.rpy is None) == (self.quat_xyzw is None):
+            raise ValueError("a pose needs exactly one of rpy or quat_xyzw besides xyz")
 
     def matrix(self) -> np.ndarray:
         """The 4x4 transform of this pose."""
@@ -303,6 +303,8 @@ def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
     except RobotModelError as exc:
         return [("robot.model", cfg.robot.model, str(exc))]
     q = cfg.home_q()
+    if not np.all(np.isfinite(q)):
+        return [("robot.home", cfg.robot.home, "joint values must be finite numbers (rad)")]
     if not arm.within_limits(q):
         bad = [arm.joint_names[i] for i in range(6) if not arm.lower[i] <= q[i] <= arm.upper[i]]
         return [
@@ -352,9 +354,17 @@ def load_cell(path: str | Path | None = None) -> CellConfig:
     if path is None or str(path) in BUILTIN_CELLS:
         path = builtin_cell_path(str(path) if path else "motorcycle_frame")
     path = Path(path)
+    if path.is_dir():
+        raise ConfigError(str(path), [("(file)", str(path), "is a directory, not a cell file")])
     if not path.is_file():
         raise ConfigError(str(path), [("(file)", str(path), "no such file")])
-    return parse_cell(path.read_text(), str(path), path.resolve())
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (UnicodeDecodeError, PermissionError) as exc:
+        raise ConfigError(
+            str(path), [("(file)", str(path), f"cannot be read as UTF-8 text: {exc}")]
+        ) from exc
+    return parse_cell(text, str(path), path.resolve())
 
 
 def load_builtin_cell(name: str = "motorcycle_frame") -> CellConfig:

@@ -33,6 +33,10 @@ from robots.urdf_writer import URDF_DIR
 Array = NDArray[np.float64]
 
 FRAMES = ("tcp", "tool0", "flange")
+#: ``tool0`` is ``flange`` (= link_6) turned +90 deg about y; this maps flange into tool0
+_T_TOOL0_FLANGE = np.array(
+    [[0.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0, 0, 0, 1.0]]
+)
 
 
 @dataclass(frozen=True)
@@ -160,9 +164,13 @@ class Arm:
         return T @ self.T_tool0_tcp if frame == "tcp" else T
 
     def fk_dh(self, q: ArrayLike, frame: str = "tcp") -> Array:
-        """Like :meth:`fk` for ``tcp``/``tool0`` from the D-H table; ``q`` may be (N, 6)."""
+        """Like :meth:`fk` but from the D-H table; ``q`` may be (N, 6) for (N, 4, 4)."""
+        if frame not in FRAMES:
+            raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
         T = self.T_cell_base @ fk_dh(self.dh, q)
-        return T @ self.T_tool0_tcp if frame == "tcp" else T
+        if frame == "tcp":
+            return T @ self.T_tool0_tcp
+        return T @ _T_TOOL0_FLANGE if frame == "flange" else T
 
     def ik(self, T_cell_tcp: ArrayLike) -> IKResult:
         """Every joint solution placing the TCP at ``T_cell_tcp`` (see :mod:`robots.ik`)."""

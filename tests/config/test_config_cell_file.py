@@ -107,7 +107,9 @@ def test_home_in_collision() -> None:
     flange = Arm().fk([0, 0, 0, 0, 0.5236, 0], "flange")[:3, 3].tolist()
 
     def change(d: dict) -> None:
-        d["environment"]["obstacles"] = [{"sphere": {"radius": 0.1}, "pose": {"xyz": flange}}]
+        d["environment"]["obstacles"] = [
+            {"sphere": {"radius": 0.1}, "pose": {"xyz": flange, "rpy": [0, 0, 0]}}
+        ]
 
     field, _, msg = _problem(_with(change))
     assert field == "robot.home" and "in collision" in msg
@@ -134,3 +136,31 @@ def test_missing_file_and_bad_yaml(tmp_path: Path) -> None:
     bad.write_text("name: [unclosed\n")
     with pytest.raises(ConfigError, match=r"bad.yaml: \(yaml\)"):
         load_cell(bad)
+
+
+def test_nan_and_inf_are_refused() -> None:
+    field, _, _ = _problem(_with(lambda d: d["part"]["base"].update(xyz=[float("nan"), 0, 0])))
+    assert field == "part.base.xyz[0]"
+    field, _, _ = _problem(_with(lambda d: d["tool"].update(standoff_m=float("inf"))))
+    assert field == "tool.standoff_m"
+
+
+def test_pose_needs_exactly_one_rotation() -> None:
+    field, _, msg = _problem(_with(lambda d: d["part"]["base"].pop("rpy")))
+    assert field == "part.base" and "exactly one of rpy or quat_xyzw" in msg
+    both = {"xyz": [0, 0, 0], "rpy": [0, 0, 0], "quat_xyzw": [0, 0, 0, 1]}
+    field, _, _ = _problem(_with(lambda d: d["part"].update(base=both)))
+    assert field == "part.base"
+    quat = {"xyz": [1.1, 0, 0.55], "quat_xyzw": [0, 0, 0, 1]}
+    assert (
+        parse_cell(_with(lambda d: d["part"].update(base=quat)), "cell.yaml").part.base.rpy is None
+    )
+
+
+def test_directory_and_binary_files_are_refused(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="is a directory"):
+        load_cell(tmp_path)
+    binary = tmp_path / "cell.yaml"
+    binary.write_bytes(b"name: \xff\xfe\x00bad")
+    with pytest.raises(ConfigError, match="UTF-8"):
+        load_cell(binary)

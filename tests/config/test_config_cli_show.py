@@ -26,9 +26,9 @@ def test_show_reports_an_unreachable_hole(
         """
 name: far
 robot: {model: abb_irb2600_20_165, home: [0, 0, 0, 0, 0.5, 0]}
-tool: {tool0_to_tcp: {xyz: [0, 0, 0.15]}, standoff_m: 0.25}
+tool: {tool0_to_tcp: {xyz: [0, 0, 0.15], rpy: [0, 0, 0]}, standoff_m: 0.25}
 part:
-  base: {xyz: [3.0, 0, 0.5]}
+  base: {xyz: [3.0, 0, 0.5], rpy: [0, 0, 0]}
   holes: [{id: FAR, position: [0, 0, 0], normal: [0, 0, 1], diameter: 0.01}]
 """
     )

@@ -39,14 +39,19 @@ def test_reference_reach_and_flange_at_zero(name: str) -> None:
     assert np.allclose(arm.fk(np.zeros(6), "flange")[:3, 3], FLANGE_AT_ZERO[name], atol=1e-12)
     # tool0 is link_6 turned +90 deg about y: its z axis is the flange normal (+x at q = 0)
     assert np.allclose(arm.fk(np.zeros(6), "tool0")[:3, 2], [1.0, 0.0, 0.0], atol=1e-12)
-    # the wrist centre never gets farther from the J2 axis than the arm is long
+    # the wrist centre stays within the annulus the upper arm and forearm can span about J2
     rng = np.random.default_rng(1)
     q = rng.uniform(arm.lower, arm.upper, (2000, 6))
     T = fk_dh(dh_table(name), q)
     wrist = T[:, :3, 3] - spec.d6 * T[:, :3, 2]
-    radial = np.hypot(wrist[:, 0], wrist[:, 1])
-    to_shoulder = np.hypot(np.abs(radial - spec.a1 * 0), wrist[:, 2] - spec.d1)
-    assert to_shoulder.max() <= spec.a1 + spec.a2 + np.hypot(spec.d4, spec.a3) + 1e-9
+    shoulder = np.column_stack(
+        (spec.a1 * np.cos(q[:, 0]), spec.a1 * np.sin(q[:, 0]), np.full(len(q), spec.d1))
+    )
+    span = np.linalg.norm(wrist - shoulder, axis=1)
+    forearm = np.hypot(spec.d4, spec.a3)
+    assert span.max() <= spec.a2 + forearm + 1e-9
+    assert span.min() >= abs(spec.a2 - forearm) - 1e-9
+    assert span.max() > 0.95 * (spec.a2 + forearm)  # the sample reaches near full stretch
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -77,3 +82,6 @@ def test_tcp_frame_follows_the_tool_and_base() -> None:
     assert np.allclose(T_tcp[:3, 3], T_tool0[:3, 3] + 0.15 * T_tool0[:3, 2])
     assert np.allclose(T_tool0, T_cell_base @ fk_dh(arm.dh, q))
     assert np.allclose(arm.fk_dh(q), T_tcp)
+    assert np.allclose(arm.fk_dh(q, "flange"), arm.fk(q, "flange"))
+    with pytest.raises(ValueError, match="frame"):
+        arm.fk_dh(q, "TCP")

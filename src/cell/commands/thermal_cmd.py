@@ -34,6 +34,7 @@ from robots.thermal import (
     simulate_observations,
 )
 from robots.thermal.csvio import read_observations, read_poses, write_observations
+from robots.thermal.errors import ThermalDataError
 from robots.thermal.modelfile import load_model, save_model
 from robots.thermal.plan import view_plan
 
@@ -97,6 +98,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     pred.add_argument("-o", "--output", type=Path, help="output CSV (default: standard output)")
     pred.add_argument(
         "--command",
+        dest="joint_command",
         action="store_true",
         help="also give the joint vector that puts the warm TCP on its nominal pose "
         "(q*_cmd_rad, command_status); exit code 1 if any does not converge",
@@ -195,12 +197,31 @@ def run_identify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_joint_limits(path: Path, robot_model: str, q_rad: np.ndarray) -> None:
+    """Refuse joint vectors outside the limits of the model's arm, naming the line and column."""
+    spec = MODELS.get(robot_model)
+    if spec is None:
+        return
+    lower, upper = spec.limits()
+    outside = np.argwhere((q_rad < lower - 1e-9) | (q_rad > upper + 1e-9))
+    if len(outside):
+        row, joint = (int(v) for v in outside[0])
+        raise ThermalDataError(
+            str(path),
+            f"q{joint + 1}_rad = {q_rad[row, joint]:.6g} is outside the {spec.title} limits "
+            f"[{lower[joint]:.4g}, {upper[joint]:.4g}] rad",
+            line=row + 2,
+            column=f"q{joint + 1}_rad",
+        )
+
+
 def run_predict(args: argparse.Namespace) -> int:
     """Compensated TCP positions (and optionally commands) for every row of POSES.csv."""
     model = load_model(args.model)
     names = model.spec.sensor_names
     used = tuple(dict.fromkeys(names[i] for i in model.spec.sensor_of_link))
     poses = read_poses(args.poses, names, used)
+    _check_joint_limits(args.poses, model.robot_model, poses.q_rad)
     T_cell_tcp = model.T_cell_base @ model.fk(poses.q_rad, poses.temps_degC) @ model.T_tool0_tcp
     nominal = model.T_cell_base @ model.fk(
         poses.q_rad, np.broadcast_to(model.spec.reference_degC, poses.temps_degC.shape)
@@ -209,7 +230,7 @@ def run_predict(args: argparse.Namespace) -> int:
     drift = p - (nominal @ model.T_tool0_tcp)[:, :3, 3]
     header = list(poses.header) + list(PREDICT_COLUMNS)
     cmds = []
-    if args.command:
+    if args.joint_command:
         header += [f"q{i}_cmd_rad" for i in range(1, 7)] + ["command_status"]
         cmds = [command(model, q, T) for q, T in zip(poses.q_rad, poses.temps_degC, strict=True)]
     buf = io.StringIO()
@@ -234,7 +255,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     from cell.config import load_cell
     from cell.errors import ConfigError
 
-    if args.hours <= 0 or args.every_s <= 0 or args.noise_um < 0:
+    if not (0 < args.hours < 1e3 and 0 < args.every_s < 1e6 and 0 <= args.noise_um < 1e6):
         raise ConfigError(
             "holecell thermal simulate",
             [

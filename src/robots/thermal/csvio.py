@@ -53,10 +53,17 @@ class PoseRows:
 
 def _read(path: str | Path) -> tuple[list[str], list[list[str]]]:
     p = Path(path)
+    if p.is_dir():
+        raise ThermalDataError(str(path), "is a directory, not a CSV file")
     if not p.is_file():
         raise ThermalDataError(str(path), "no such file")
-    with p.open(newline="", encoding="utf-8") as fh:
-        table = [row for row in csv.reader(fh) if any(cell.strip() for cell in row)]
+    try:
+        with p.open(newline="", encoding="utf-8") as fh:
+            table = [row for row in csv.reader(fh) if any(cell.strip() for cell in row)]
+    except UnicodeDecodeError as exc:
+        raise ThermalDataError(
+            str(path), f"not a UTF-8 text file ({exc.reason} at byte {exc.start})"
+        ) from exc
     if not table:
         raise ThermalDataError(str(path), "the file is empty; expected a header row")
     header = [h.strip() for h in table[0]]
