@@ -18,7 +18,7 @@ from cell.results import HoleResult, deviations
 from measure import HoleMeasurement, MeasurementError, StereoCalibration, head_frame, measure_hole
 from measure.errors import HoleNotFoundError
 from robots import Arm
-from robots.thermal.compensate import compensated_T_base_tcp
+from robots.thermal.compensate import compensated_T_cell_tcp
 from robots.thermal.model import ThermalModel
 from robots.transforms import invert
 
@@ -26,10 +26,11 @@ from robots.transforms import invert
 def T_cell_tcp(
     arm: Arm, model: ThermalModel | None, q_rad: np.ndarray, temps_c: np.ndarray
 ) -> np.ndarray:
-    """TCP pose in the cell: compensated if a thermal model is given, nominal otherwise."""
+    """TCP pose in the cell: compensated if a thermal model is given, nominal otherwise; always
+    with the cell's base pose and tool (the model was checked against them when loaded)."""
     if model is None:
         return arm.fk(q_rad, "tcp")
-    return arm.T_cell_base @ compensated_T_base_tcp(model, q_rad, temps_c)
+    return compensated_T_cell_tcp(model, arm.T_cell_base, arm.T_tool0_tcp, q_rad, temps_c)
 
 
 def inspect_hole(

@@ -16,7 +16,7 @@ import numpy as np
 
 from cell.config import CellConfig
 from robots import Arm
-from robots.thermal.compensate import compensated_T_base_tcp
+from robots.thermal.compensate import compensated_T_cell_tcp
 from robots.thermal.errors import ThermalError
 from robots.thermal.identify import IdentificationResult, identify
 from robots.thermal.model import ThermalModel, ThermalSpec
@@ -96,7 +96,9 @@ class ThermalUpdate:
         targets = {r.id: np.asarray(r.position, float) for r in self.cell.reference_targets}
         err = []
         for _, target, q, temps, p_tcp in self.rows:
-            T_cell_tcp = self.arm.T_cell_base @ compensated_T_base_tcp(model, q, temps)
+            T_cell_tcp = compensated_T_cell_tcp(
+                model, self.arm.T_cell_base, self.arm.T_tool0_tcp, q, temps
+            )
             T_tcp_cell = invert(T_cell_tcp)
             pred = T_tcp_cell[:3, :3] @ targets[target] + T_tcp_cell[:3, 3]
             err.append(np.sum((p_tcp - pred) ** 2))

@@ -36,6 +36,7 @@ def _result(hole: str, stop: int, status: str = "ok") -> HoleResult:
         q_rad=(0.0,) * 6,
         temperatures_c=(20.0, 21.0),
         reason="" if measured else "no hole found",
+        passed=(status != "fail") if measured else None,
     )
 
 

@@ -18,7 +18,9 @@ from cell.reference import plan_reference_tour
 from cell.report import format_summary, write_report
 from cell.run_setup import RunFiles, check_tour, resume_run, start_run
 from cell.runner import RunFaultError, Runner, RunOptions
+from cell.thermal_check import check_model_for_cell, check_model_sensors
 from planner import load_tour
+from robots.thermal.model import ThermalModel
 from robots.thermal.modelfile import load_model
 
 
@@ -57,24 +59,43 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=run_run)
 
 
-def _prepare(args: argparse.Namespace) -> tuple[CellConfig, Callable[[], RunFiles]]:
-    """The cell, and how to open the run's store once controller and head answer. Every input
-    is checked here, before anything is connected or written."""
+def _thermal_model(path: str | None, cell: CellConfig) -> ThermalModel | None:
+    """The ``--thermal`` model, refused unless it was identified for this cell's arm, D-H table,
+    base pose and tool (the sensor count is checked against the controller once connected)."""
+    if not path:
+        return None
+    model = load_model(path)
+    check_model_for_cell(model, cell.build_arm(), cell.robot.model, path)
+    return model
+
+
+def _prepare(
+    args: argparse.Namespace,
+) -> tuple[CellConfig, ThermalModel | None, Callable[[], RunFiles]]:
+    """The cell, the checked thermal model, and how to open the run's store once controller and
+    head answer. Every input is checked here, before anything is planned, connected or
+    written."""
     if args.resume:
         if args.tour or args.cell:
             raise CellError("--resume takes the cell and tour from the run; give neither")
         files = resume_run(args.resume)
-        return files.cell, lambda: files
+        try:
+            model = _thermal_model(args.thermal, files.cell)
+        except BaseException:
+            files.store.close()
+            raise
+        return files.cell, model, lambda: files
     if not args.tour or not args.cell:
         raise CellError("give TOUR and --cell CELL (or --resume RUN_DIR)")
     cell = load_cell(args.cell)
     tour = load_tour(args.tour)
     check_tour(tour, cell, args.tour)
+    model = _thermal_model(args.thermal, cell)
     reference = (
         plan_reference_tour(cell) if cell.reference_targets and args.reference_rounds else None
     )
     out = Path(args.out) if args.out else Path("runs") / Path(args.tour).stem
-    return cell, lambda: start_run(out, cell, tour, args.tour, args.port, reference)
+    return cell, model, lambda: start_run(out, cell, tour, args.tour, args.port, reference)
 
 
 def _rrd_path(run_dir: Path) -> Path:
@@ -91,8 +112,7 @@ def _ask_start() -> None:
 
 def run_run(args: argparse.Namespace) -> int:
     """Handler of ``holecell run``."""
-    cell, open_files = _prepare(args)
-    model = load_model(args.thermal) if args.thermal else None
+    cell, model, open_files = _prepare(args)
     client = ControllerClient(args.port)
     camera = recorder = files = None
     try:
@@ -102,6 +122,8 @@ def run_run(args: argparse.Namespace) -> int:
                 f"controller at {args.port} drives {client.identity.robot_model!r}, "
                 f"the cell has {cell.robot.model!r}"
             )
+        if model is not None:
+            check_model_sensors(model, len(client.status().temperatures_c), args.thermal)
         camera = NetworkCamera(args.camera, cell_stereo(cell))
         files = open_files()
         run_dir = files.store.path.parent

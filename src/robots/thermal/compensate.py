@@ -31,6 +31,24 @@ def compensated_T_base_tcp(model: ThermalModel, q: ArrayLike, temps_degC: ArrayL
     return model.fk(q, temps_degC) @ model.T_tool0_tcp
 
 
+def compensated_T_cell_tcp(
+    model: ThermalModel,
+    T_cell_base: ArrayLike,
+    T_tool0_tcp: ArrayLike,
+    q: ArrayLike,
+    temps_degC: ArrayLike,
+) -> Array:
+    """Compensated ``T_cell_tcp`` (..., 4, 4): ``T_cell_base @ model.fk(q, T) @ T_tool0_tcp``.
+
+    The one place where the compensated TCP pose in the cell is formed. The base pose and the
+    tool are given explicitly (the cell's, or the model's own), so a caller never mixes a
+    model's tool with another cell's base. ``q`` in rad, readings in degC.
+    """
+    T_cb = np.asarray(T_cell_base, float)
+    T_tt = np.asarray(T_tool0_tcp, float)
+    return T_cb @ model.fk(q, temps_degC) @ T_tt
+
+
 def T_part_camera(
     model: ThermalModel,
     q: ArrayLike,
@@ -44,7 +62,9 @@ def T_part_camera(
     TCP frame (identity when the measurement is expressed in the TCP frame).
     """
     T_tcp_cam = np.eye(4) if T_tcp_cam is None else np.asarray(T_tcp_cam, float)
-    T_cell_tcp = model.T_cell_base @ compensated_T_base_tcp(model, q, temps_degC)
+    T_cell_tcp = compensated_T_cell_tcp(
+        model, model.T_cell_base, model.T_tool0_tcp, q, temps_degC
+    )
     return invert(T_cell_part) @ T_cell_tcp @ T_tcp_cam
 
 
