@@ -59,7 +59,9 @@ class RunOptions:
         reconnect_budget_s: how long a dead link is retried before the run stops.
         reference_rounds: rounds over the reference targets before the holes (0: none).
         reference_interval_s: controller-clock seconds between the starts of two rounds.
-        reference_c: temperature (degC) at which the nominal kinematics hold.
+
+    The reference temperatures of an identified model are the first reference round's readings
+    (the rule of ``holecell thermal identify``), not a fixed value.
     """
 
     settle_s: float = 0.2
@@ -67,7 +69,6 @@ class RunOptions:
     reconnect_budget_s: float = 15.0
     reference_rounds: int = 1
     reference_interval_s: float = 300.0
-    reference_c: float = 20.0
 
 
 @dataclass
@@ -130,7 +131,7 @@ class Runner:
         self.recorder = recorder
         self.arm = cell.build_arm()
         self.holes = {h.id: h for h in cell.holes_in_cell()}
-        self.thermal = ThermalUpdate(cell, self.arm, self.options.reference_c)
+        self.thermal = ThermalUpdate(cell, self.arm)
         self._T_head_left = invert(head_frame(camera.stereo))
         self._loaded: Tour | None = None
         self._need_load = False
@@ -264,7 +265,7 @@ class Runner:
                     continue
                 p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
                 target = target_of(s.hole_id)
-                self.thermal.add(st.time_s, target, st.q_rad, st.temperatures_c, p_tcp)
+                self.thermal.add(st.time_s, target, st.q_rad, st.temperatures_c, p_tcp, rnd)
                 self.progress("reference", {"round": rnd, "target": s.hole_id})
             self._move(len(tour.stops), "reference home")
             if rnd + 1 < self.options.reference_rounds:

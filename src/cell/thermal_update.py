@@ -6,10 +6,15 @@ reference round the runner identifies a model from every row so far with
 :func:`robots.thermal.identify.identify`; what the data cannot determine is refused there and
 reported here. Sensors: six readings are taken as one sensor per joint (link i -> sensor i),
 one reading as a sensor shared by every link; other counts are refused.
+
+The reference temperatures (where the nominal D-H table holds) follow the rule of
+``holecell thermal identify`` (:func:`robots.thermal.identify.reference_from_cold`): the
+readings of the cold state, here the per-sensor mean of the first reference round's readings.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,12 +29,18 @@ from robots.thermal.observations import CellGeometry, Observations
 from robots.transforms import invert
 
 
-def sensor_spec(n_sensors: int, reference_c: float) -> ThermalSpec:
-    """The sensor-to-link map (:meth:`ThermalSpec.mapped`) for ``n_sensors`` readings, every
-    reference at ``reference_c``: six sensors ``j1..j6`` one per link, or one shared sensor."""
+def sensor_spec(n_sensors: int, reference_c: float | Sequence[float]) -> ThermalSpec:
+    """The sensor-to-link map (:meth:`ThermalSpec.mapped`) for ``n_sensors`` readings with the
+    reference temperature(s) ``reference_c`` (degC; one for all or one per sensor): six sensors
+    ``j1..j6`` one per link, or one shared sensor."""
     names = tuple(f"j{i}" for i in range(1, 7)) if n_sensors == 6 else (
         tuple(f"t{i}" for i in range(1, n_sensors + 1)))  # fmt: skip
-    return ThermalSpec.mapped(names, (reference_c,) * n_sensors)
+    ref = np.broadcast_to(np.asarray(reference_c, float), (n_sensors,))
+    return ThermalSpec.mapped(names, tuple(float(v) for v in ref))
+
+
+#: one observation: (time s, target id, joints rad, readings degC, target in TCP frame m, round)
+Row = tuple[float, str, np.ndarray, np.ndarray, np.ndarray, int]
 
 
 @dataclass
@@ -38,13 +49,21 @@ class ThermalUpdate:
 
     cell: CellConfig
     arm: Arm
-    reference_c: float = 20.0
-    rows: list[tuple[float, str, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
+    rows: list[Row] = field(default_factory=list)
     result: IdentificationResult | None = None
     refusal: str = ""
 
-    def add(self, t_s: float, target: str, q: np.ndarray, temps: np.ndarray, p_tcp: np.ndarray):
-        """One observation: target ``target`` seen at ``p_tcp`` (m, TCP frame)."""
+    def add(
+        self,
+        t_s: float,
+        target: str,
+        q: np.ndarray,
+        temps: np.ndarray,
+        p_tcp: np.ndarray,
+        round_index: int = 0,
+    ) -> None:
+        """One observation of reference round ``round_index``: target ``target`` seen at
+        ``p_tcp`` (m, TCP frame)."""
         self.rows.append(
             (
                 float(t_s),
@@ -52,13 +71,20 @@ class ThermalUpdate:
                 np.asarray(q, float),
                 np.asarray(temps, float),
                 np.asarray(p_tcp, float),
+                int(round_index),
             )
         )
 
+    def reference_degC(self) -> tuple[float, ...]:
+        """Per-sensor mean reading (degC) of the first round observed: the cold state."""
+        first = min(r[5] for r in self.rows)
+        temps = np.array([r[3] for r in self.rows if r[5] == first])
+        return tuple(float(v) for v in temps.mean(axis=0))
+
     def observations(self) -> Observations:
         """The rows so far as :class:`Observations`."""
-        t, ids, q, temps, p = zip(*self.rows, strict=True)
-        spec = sensor_spec(len(temps[0]), self.reference_c)
+        t, ids, q, temps, p, _ = zip(*self.rows, strict=True)
+        spec = sensor_spec(len(temps[0]), self.reference_degC())
         return Observations(
             np.array(t),
             tuple(ids),
@@ -81,7 +107,7 @@ class ThermalUpdate:
                 self.arm.T_tool0_tcp,
                 {r.id: np.asarray(r.position, float) for r in self.cell.reference_targets},
             )
-            spec = sensor_spec(obs.temps_degC.shape[1], self.reference_c)
+            spec = sensor_spec(obs.temps_degC.shape[1], self.reference_degC())
             self.result = identify(
                 obs, geometry, self.arm.dh, spec, robot_model=self.cell.robot.model
             )
@@ -95,7 +121,7 @@ class ThermalUpdate:
         """RMS (m) of measured minus predicted target positions in the TCP frame, every row."""
         targets = {r.id: np.asarray(r.position, float) for r in self.cell.reference_targets}
         err = []
-        for _, target, q, temps, p_tcp in self.rows:
+        for _, target, q, temps, p_tcp, _ in self.rows:
             T_cell_tcp = compensated_T_cell_tcp(
                 model, self.arm.T_cell_base, self.arm.T_tool0_tcp, q, temps
             )
