@@ -37,6 +37,10 @@ from robots.transforms import invert
 log = logging.getLogger(__name__)
 T = TypeVar("T")
 
+#: the arm is at a joint vector if every joint is within this (rad; half the controller's
+#: on-path tolerance of 1e-3 degrees)
+HOME_TOL_RAD = float(np.deg2rad(0.5e-3))
+
 
 class RunFaultError(CellError):
     """The run stopped on a controller fault; ``state`` and ``fault`` as the controller said."""
@@ -150,6 +154,7 @@ class Runner:
             result.skipped = [s.hole_id for s in self.tour.stops if s.hole_id in stored]
             if todo and self.reference_tour is not None and self.options.reference_rounds > 0:
                 self._state("reference")
+                self._home_for_reference()
                 self._reference_phase()
                 result.thermal = self._identify()
             self._state("inspecting")
@@ -249,6 +254,19 @@ class Runner:
         return self._call("status", self.client.status)
 
     # --- reference targets -----------------------------------------------------------------
+    def _home_for_reference(self) -> None:
+        """Bring the arm home along the inspection tour if it is elsewhere (a resumed run stopped
+        at a hole or between holes): the reference trajectory starts at home, and a controller
+        refuses to load a trajectory the arm is not on."""
+        home = np.asarray(self.reference_tour.trajectory[0], float)
+        st = self._call("status", self.client.status)
+        if np.max(np.abs(st.q_rad - home)) <= HOME_TOL_RAD:
+            return
+        self.store.event("motion", "the arm is off home: homing along the tour before the "
+                                   "reference targets")  # fmt: skip
+        self._load(self.tour)
+        self._move(len(self.tour.stops), "home before the reference targets")
+
     def _reference_phase(self) -> None:
         tour = self.reference_tour
         self._load(tour)

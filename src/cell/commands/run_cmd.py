@@ -11,6 +11,7 @@ from cell.camera import NetworkCamera, cell_stereo
 from cell.commands.run_progress import RunBars
 from cell.config import CellConfig, load_cell
 from cell.errors import CellError
+from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError
 from cell.record import Recorder
@@ -54,7 +55,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
     p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
-    p.add_argument("--yes", action="store_true", help="start without asking")
+    p.add_argument(
+        "--reset",
+        action="store_true",
+        help="clear a latched e-stop or fault of the controller (RESET) before the "
+        "run, after the operator confirms the cell is safe (at once with --yes)",
+    )
+    p.add_argument("--yes", action="store_true", help="start (and --reset) without asking")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.set_defaults(handler=run_run)
 
@@ -106,6 +113,25 @@ def _rrd_path(run_dir: Path) -> Path:
     return path
 
 
+def _clear_fault(client: ControllerClient, args: argparse.Namespace) -> None:
+    """Refuse to start on a latched e-stop or fault unless ``--reset`` (confirmed) clears it."""
+    st = client.status()
+    if st.state not in (m.State.ESTOP, m.State.FAULT):
+        return
+    what = f"controller at {args.port} is in {st.state.name} ({st.fault.name})"
+    if not args.reset:
+        raise CellError(f"{what}: clear the cause at the cell, then run again with --reset")
+    if not args.yes and sys.stdin.isatty():
+        answer = input(f"{what}. Is the cell safe to move? Type 'reset' to send RESET: ")
+        if answer.strip() != "reset":
+            raise CellError(f"{what}: RESET not confirmed; nothing was sent")
+    client.reset()
+    st = client.status()
+    if st.state in (m.State.ESTOP, m.State.FAULT):
+        raise CellError(f"{what} after RESET: release the emergency stop at the cell first")
+    print(f"controller fault cleared ({what} before RESET)", file=sys.stderr)
+
+
 def _ask_start() -> None:
     input("press Enter to start the run (Ctrl-C to cancel) ")
 
@@ -122,6 +148,7 @@ def run_run(args: argparse.Namespace) -> int:
                 f"controller at {args.port} drives {client.identity.robot_model!r}, "
                 f"the cell has {cell.robot.model!r}"
             )
+        _clear_fault(client, args)
         if model is not None:
             check_model_sensors(model, len(client.status().temperatures_c), args.thermal)
         camera = NetworkCamera(args.camera, cell_stereo(cell))
