@@ -3,14 +3,16 @@ stop move, settle, capture, measure, compensate, compare, store; go home.
 
 States (stored as the run's timeline): ``created`` -> ``waiting`` -> ``reference`` ->
 ``inspecting`` -> ``homing`` -> ``done``; ``fault`` when the controller reports an emergency stop
-or fault, or the link stays dead beyond the reconnect budget (the arm is stopped on its path and
-the store keeps every hole measured so far). A resumed run skips every hole already stored, so
-no hole is ever stored twice and nothing stored is lost.
+or fault, the link stays dead beyond the reconnect budget, or anything else fails (camera,
+store, bad data); ``stopped`` when the operator interrupts. In every case the arm is stopped on
+its path, the reason is recorded and the store keeps every hole measured so far. A resumed run
+skips every hole already stored, so no hole is ever stored twice and nothing stored is lost.
 """
 
 from __future__ import annotations
 
 import logging
+import sqlite3
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -142,45 +144,63 @@ class Runner:
 
     # --- the state machine -----------------------------------------------------------------
     def run(self, wait_for_start: Callable[[], None] | None = None) -> RunResult:
-        """Run (or continue) the tour; returns when home or stopped by a fault."""
+        """Run (or continue) the tour; returns when home. Whatever stops it (a controller fault,
+        a dead link, an interrupt, a camera or store error) stops the arm, records the run as
+        ``fault`` (``stopped`` for an interrupt) with the reason, and is raised again."""
         t0 = time.perf_counter()
         result = RunResult("done")
-        stored = self.store.stored_ids()
         try:
-            self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
-            if wait_for_start is not None:
-                wait_for_start()
-            todo = [k for k, s in enumerate(self.tour.stops) if s.hole_id not in stored]
-            result.skipped = [s.hole_id for s in self.tour.stops if s.hole_id in stored]
-            if todo and self.reference_tour is not None and self.options.reference_rounds > 0:
-                self._state("reference")
-                self._home_for_reference()
-                self._reference_phase()
-                result.thermal = self._identify()
-            self._state("inspecting")
-            self._load(self.tour)
-            for k in todo:
-                hole, laps = self._inspect_stop(k)
-                result.stored.append(hole)
-                result.hole_timings.append(laps)
-            self._state("homing")
-            self._move(len(self.tour.stops), "home")
-            self.store.set_state("done", finished=True)
-            self.progress("state", {"state": "done"})
-        except RunFaultError as exc:
-            result.status = "fault"
-            self._safe_stop()
-            self.store.set_state("fault", str(exc))
-            self.progress("state", {"state": "fault", "message": str(exc)})
-            raise
-        except LinkError as exc:
-            result.status = "fault"
-            self.store.set_state("fault", f"link lost: {exc}")
+            self._run(result, wait_for_start)
+        except BaseException as exc:
+            result.status = self._stopped_by(exc)
             raise
         finally:
             result.timings["run_s"] = time.perf_counter() - t0
             result.link = vars(self.client.stats).copy()
         return result
+
+    def _run(self, result: RunResult, wait_for_start: Callable[[], None] | None) -> None:
+        stored = self.store.stored_ids()
+        self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
+        if wait_for_start is not None:
+            wait_for_start()
+        todo = [k for k, s in enumerate(self.tour.stops) if s.hole_id not in stored]
+        result.skipped = [s.hole_id for s in self.tour.stops if s.hole_id in stored]
+        if todo and self.reference_tour is not None and self.options.reference_rounds > 0:
+            self._state("reference")
+            self._home_for_reference()
+            self._reference_phase()
+            result.thermal = self._identify()
+        self._state("inspecting")
+        self._load(self.tour)
+        for k in todo:
+            hole, laps = self._inspect_stop(k)
+            result.stored.append(hole)
+            result.hole_timings.append(laps)
+        self._state("homing")
+        self._move(len(self.tour.stops), "home")
+        self.store.set_state("done", finished=True)
+        self.progress("state", {"state": "done"})
+
+    def _stopped_by(self, exc: BaseException) -> str:
+        """Stop the arm and record why the run stopped; returns the run state it is left in."""
+        if isinstance(exc, KeyboardInterrupt):
+            state, message = "stopped", "interrupted by the operator"
+        elif isinstance(exc, RunFaultError):
+            state, message = "fault", str(exc)
+        elif isinstance(exc, LinkError):
+            state, message = "fault", f"link lost: {exc}"
+        else:
+            state, message = "fault", f"{type(exc).__name__}: {exc}"
+        self._safe_stop()
+        try:
+            self.store.set_state(state, message)
+        except (CellError, sqlite3.Error) as err:
+            log.error("run %s (%s) could not be recorded: %s", state, message, err)
+        self.progress("state", {"state": state, "message": message})
+        if self.recorder is not None:
+            self.recorder.state(state)
+        return state
 
     def _state(self, state: str, **extra: int) -> None:
         self.store.set_state(state)
@@ -244,10 +264,14 @@ class Runner:
         self.store.event("link", f"{where}: link restored")
 
     def _safe_stop(self) -> None:
+        """Ask the controller to stop the arm; a failure is recorded, never raised."""
         try:
             self.client.stop()
-        except (LinkError, RequestRefusedError) as exc:
-            self.store.event("fault", f"stop request failed: {exc}")
+        except (CellError, OSError, KeyboardInterrupt) as exc:
+            try:
+                self.store.event("fault", f"stop request failed: {exc}")
+            except (CellError, sqlite3.Error) as err:
+                log.error("stop request failed (%s) and could not be recorded: %s", exc, err)
 
     def _settled_status(self) -> m.Status:
         time.sleep(self.options.settle_s)

@@ -8,17 +8,17 @@ from collections.abc import Callable
 from pathlib import Path
 
 from cell.camera import NetworkCamera, cell_stereo
+from cell.commands.argtypes import non_negative_float, non_negative_int
 from cell.commands.run_progress import RunBars
 from cell.config import CellConfig, load_cell
 from cell.errors import CellError
 from cell.link import messages as m
 from cell.link.client import ControllerClient
-from cell.link.errors import LinkError
 from cell.record import Recorder
 from cell.reference import plan_reference_tour
 from cell.report import format_summary, write_report
 from cell.run_setup import RunFiles, check_tour, resume_run, start_run
-from cell.runner import RunFaultError, Runner, RunOptions
+from cell.runner import Runner, RunOptions
 from cell.thermal_check import check_model_for_cell, check_model_sensors
 from planner import load_tour
 from robots.thermal.model import ThermalModel
@@ -48,10 +48,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default=None, help="run directory to create (default: runs/<tour>)")
     p.add_argument("--resume", metavar="RUN_DIR", help="continue the run stored in RUN_DIR")
     p.add_argument("--thermal", help="thermal.json model to start from (holecell thermal)")
-    p.add_argument("--reference-rounds", type=int, default=1, help="rounds over the targets")
-    p.add_argument("--reference-interval-s", type=float, default=300.0,
+    p.add_argument("--reference-rounds", type=non_negative_int, default=1,
+                   help="rounds over the targets")  # fmt: skip
+    p.add_argument("--reference-interval-s", type=non_negative_float, default=300.0,
                    help="controller seconds between reference rounds")  # fmt: skip
-    p.add_argument("--settle-s", type=float, default=0.2, help="settling wait (s)")
+    p.add_argument("--settle-s", type=non_negative_float, default=0.2,
+                   help="settling wait (s)")  # fmt: skip
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
     p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
@@ -132,6 +134,15 @@ def _clear_fault(client: ControllerClient, args: argparse.Namespace) -> None:
     print(f"controller fault cleared ({what} before RESET)", file=sys.stderr)
 
 
+def _report_stopped_run(run_dir: Path) -> None:
+    """Write the report of a run that stopped early and print its summary on stderr (a store
+    that cannot be read any more is said so, not raised over the reason the run stopped)."""
+    try:
+        print(format_summary(write_report(run_dir)), file=sys.stderr)
+    except (CellError, OSError) as exc:
+        print(f"no report written: {exc}", file=sys.stderr)
+
+
 def _ask_start() -> None:
     input("press Enter to start the run (Ctrl-C to cancel) ")
 
@@ -168,9 +179,9 @@ def run_run(args: argparse.Namespace) -> int:
                         files.reference, model, progress, recorder)  # fmt: skip
         try:
             result = runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
-        except (RunFaultError, LinkError):
+        except BaseException:
             files.store.close()
-            print(format_summary(write_report(run_dir)), file=sys.stderr)
+            _report_stopped_run(run_dir)
             raise
         if result.thermal:
             print(result.thermal)
