@@ -26,7 +26,7 @@ from cell.errors import CellError
 from cell.inspect_hole import T_cell_tcp, inspect_hole
 from cell.link import messages as m
 from cell.link.client import ControllerClient
-from cell.link.errors import LinkError, RequestRefusedError
+from cell.link.errors import LinkError, MoveTimeoutError, RequestRefusedError
 from cell.reference import target_of
 from cell.results import HoleResult
 from cell.store import Store
@@ -239,6 +239,9 @@ class Runner:
         while True:
             try:
                 st = self._call(where, go)
+            except MoveTimeoutError as exc:
+                self._safe_stop()
+                raise RunFaultError(where, exc.state, "move timed out") from exc
             except RequestRefusedError as exc:
                 if exc.code == m.Nak.NOT_LOADED:  # the controller lost the trajectory
                     self.store.event("motion", f"{where}: {exc}; reloading")

@@ -15,7 +15,7 @@ from cell.cli import main
 from cell.link import messages as m
 from cell.link.client import ControllerClient, LinkOptions
 from cell.run_setup import start_run
-from cell.runner import Runner, RunOptions
+from cell.runner import RunFaultError, Runner, RunOptions
 from cell.sim.camserver import CameraServer
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
@@ -102,3 +102,23 @@ def test_cli_refuses_negative_numbers(small_cell: SmallCell, capsys, option, val
         main(["run", str(small_cell.tour_path), "--cell", str(small_cell.path), "--port", "x",
               "--camera", "tcp://x:1", option, value])  # fmt: skip
     assert exc.value.code == 2 and option in capsys.readouterr().err
+
+
+def test_move_timeout_is_a_fault_not_a_dead_link(small_cell: SmallCell, tmp_path: Path) -> None:
+    """A slow arm (the simulation at a tenth of real time) misses the move timeout: the run
+    stops the arm and faults at once, without reconnecting or reloading the trajectory."""
+    files = start_run(tmp_path, small_cell.cell, small_cell.tour, "tour.json", "sim")
+    slow = WorldOptions(speed=0.1, drift=steady_drift())
+    with SimCell.start(small_cell.cell, slow) as sim, ControllerClient(sim.url, FAST_LINK) as c:
+        options = RunOptions(settle_s=0.0, reference_rounds=0, move_timeout_s=0.3)
+        runner = Runner(files.cell, files.tour, files.store, c, sim.camera, options)
+        try:
+            with pytest.raises(RunFaultError, match="move timed out"):
+                runner.run()
+            assert sim.controller.s.state == m.State.STOPPED
+            assert c.stats.reconnects == 0
+            events = files.store.events()
+        finally:
+            files.store.close()
+    assert not any(e["kind"] == "link" for e in events)
+    assert events[-1]["state"] == "fault"

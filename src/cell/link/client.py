@@ -18,7 +18,7 @@ import numpy as np
 
 from cell.link import frame as fr
 from cell.link import messages as m
-from cell.link.errors import LinkError, RequestRefusedError
+from cell.link.errors import LinkError, MoveTimeoutError, RequestRefusedError
 from cell.link.transport import open_port, read_some, write_all
 
 log = logging.getLogger(__name__)
@@ -219,8 +219,9 @@ class ControllerClient:
 
     def wait_in_position(self, k: int, timeout_s: float) -> m.Status:
         """Poll STATUS until the arm reports IN_POSITION at stop ``k``; returns that status.
-        Raises :class:`cell.link.errors.LinkError` on timeout, and returns early with any other
-        terminal state (STOPPED, ESTOP, FAULT) for the caller to handle."""
+        Raises :class:`cell.link.errors.MoveTimeoutError` (not a link error: the link answers)
+        on timeout, and returns early with any other terminal state (STOPPED, ESTOP, FAULT) for
+        the caller to handle."""
         deadline = time.monotonic() + timeout_s
         while True:
             st = self.status()
@@ -229,5 +230,5 @@ class ControllerClient:
             if st.state in (m.State.STOPPED, m.State.ESTOP, m.State.FAULT, m.State.IDLE):
                 return st
             if time.monotonic() > deadline:
-                raise LinkError(self.url, f"stop {k} not reached within {timeout_s:.1f} s")
+                raise MoveTimeoutError(self.url, k, timeout_s, st.state.name)
             time.sleep(self.options.poll_period_s)

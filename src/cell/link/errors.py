@@ -31,3 +31,14 @@ class RequestRefusedError(CellError):
         self.code = code
         self.text = text
         super().__init__(f"controller refused {request}: {text} (NAK code {code})")
+
+
+class MoveTimeoutError(CellError):
+    """The arm did not reach stop ``stop`` within ``timeout_s`` while the link kept answering:
+    a motion problem, not a dead link (no reconnect, no reload while the arm may move)."""
+
+    def __init__(self, url: str, stop: int, timeout_s: float, state: str) -> None:
+        self.url, self.stop, self.timeout_s, self.state = url, stop, timeout_s, state
+        super().__init__(
+            f"controller {url}: stop {stop} not reached within {timeout_s:.1f} s (state {state})"
+        )
