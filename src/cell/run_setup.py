@@ -38,7 +38,8 @@ class TourMismatchError(CellError):
 def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False) -> None:
     """Refuse a tour not made for ``cell`` (:func:`planner.check_tour_for_cell`: robot model, cell
     name, SHA-256 of the cell file text; here also joint names, trajectory shape, stops on the
-    trajectory, known holes). Reference tours are checked for the robot only."""
+    trajectory, known holes, no hole visited twice). Reference tours are checked for the robot
+    only."""
     if reference:
         if tour.robot_model != cell.robot.model:
             raise TourMismatchError(where, "robot model", tour.robot_model, cell.robot.model)
@@ -52,6 +53,10 @@ def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False
     traj = np.asarray(tour.trajectory)
     if traj.ndim != 2 or traj.shape[1] != 6 or len(traj) < 2:
         raise CellError(f"{where}: trajectory has shape {traj.shape}, expected (N >= 2, 6)")
+    ids = [s.hole_id for s in tour.stops]
+    repeated = sorted({h for h in ids if ids.count(h) > 1})
+    if repeated:
+        raise CellError(f"{where}: stops[].hole_id: holes visited more than once: {repeated[:5]}")
     if not reference:
         known = {h.id for h in cell.part.holes}
         unknown = [s.hole_id for s in tour.stops if s.hole_id not in known]

@@ -6,7 +6,9 @@ planned hole with its stop index and nominal geometry), ``measurements`` (at mos
 hole: a UNIQUE key makes storing a hole twice impossible), ``events`` (run state changes,
 faults, retries, thermal updates).
 
-Each hole is stored in one transaction, so a killed process leaves every hole either fully
+A new store is built completely in a temporary file next to it and then renamed into place, so
+a failed creation leaves no half-made ``results.sqlite`` behind. Each hole is stored in one
+transaction, so a killed process leaves every hole either fully
 stored or not at all. Opening checks the schema and the file's integrity first and refuses a
 corrupt or foreign file without writing to it.
 """
@@ -14,6 +16,7 @@ corrupt or foreign file without writing to it.
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
 import time
 from pathlib import Path
@@ -86,29 +89,19 @@ class Store:
         if path.exists():
             raise StoreError(path, "a run is stored here already; use --resume or another --out")
         path.parent.mkdir(parents=True, exist_ok=True)
-        con = _connect(path)
-        with con:
-            con.executescript(_SCHEMA)
-            con.execute("INSERT INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
-            con.execute(
-                "INSERT INTO run VALUES (1, ?, ?, ?, ?, ?, ?, ?, ?, 'created', ?, NULL)",
-                (
-                    cell_name,
-                    cell_sha256,
-                    cell_text,
-                    cell_path,
-                    tour_text,
-                    reference_text,
-                    robot_model,
-                    port,
-                    time.time(),
-                ),
-            )
-            con.executemany(
-                "INSERT INTO holes VALUES (?, ?, ?)",
-                [(h, k, json.dumps(nom)) for h, k, nom in holes],
-            )
-        return cls(path, con)
+        run_row = (cell_name, cell_sha256, cell_text, cell_path, tour_text, reference_text,
+                   robot_model, port, time.time())  # fmt: skip
+        tmp = path.with_name(f"{FILENAME}.creating-{os.getpid()}")
+        try:
+            _build(tmp, run_row, holes)
+            if path.exists():
+                raise StoreError(path, "a run was stored here meanwhile; not overwritten")
+            os.replace(tmp, path)
+        except sqlite3.Error as exc:
+            raise StoreError(path, f"cannot create the store ({exc}); nothing was written") from exc
+        finally:
+            tmp.unlink(missing_ok=True)
+        return cls(path, _connect(path))
 
     @classmethod
     def open(cls, run_dir: str | Path) -> Store:
@@ -223,6 +216,31 @@ class Store:
                 d["passed"] = None if d.get("center_part_m") is None else d["status"] != "fail"
             out.append(HoleResult(**d))
         return out
+
+
+def _build(
+    tmp: Path, run_row: tuple[Any, ...], holes: list[tuple[str, int, dict[str, Any]]]
+) -> None:
+    """Write a complete new store into ``tmp`` (a rollback-journal file, closed on return):
+    either every table and row is there, or the caller removes the file."""
+    tmp.unlink(missing_ok=True)
+    con = sqlite3.connect(str(tmp), isolation_level=None)
+    try:
+        con.execute("BEGIN")
+        for statement in _SCHEMA.split(";"):
+            if statement.strip():
+                con.execute(statement)
+        con.execute("INSERT INTO meta VALUES ('schema_version', ?)", (str(SCHEMA_VERSION),))
+        con.execute(
+            "INSERT INTO run VALUES (1, ?, ?, ?, ?, ?, ?, ?, ?, 'created', ?, NULL)", run_row
+        )
+        con.executemany(
+            "INSERT INTO holes VALUES (?, ?, ?)",
+            [(h, k, json.dumps(nom)) for h, k, nom in holes],
+        )
+        con.execute("COMMIT")
+    finally:
+        con.close()
 
 
 def _connect(path: Path) -> sqlite3.Connection:

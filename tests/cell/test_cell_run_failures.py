@@ -122,3 +122,17 @@ def test_move_timeout_is_a_fault_not_a_dead_link(small_cell: SmallCell, tmp_path
             files.store.close()
     assert not any(e["kind"] == "link" for e in events)
     assert events[-1]["state"] == "fault"
+
+
+def test_tour_with_a_repeated_stop_is_refused(small_cell: SmallCell, tmp_path: Path,
+                                              capsys) -> None:  # fmt: skip
+    d = json.loads(small_cell.tour_path.read_text())
+    d["stops"].append(d["stops"][0])
+    bad = tmp_path / "twice.json"
+    bad.write_text(json.dumps(d))
+    run = tmp_path / "run"
+    code = main(["run", str(bad), "--cell", str(small_cell.path), "--port", "/dev/null",
+                 "--camera", "tcp://127.0.0.1:1", "--out", str(run)])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "twice.json" in err and "stops[].hole_id" in err, err
+    assert d["stops"][0]["hole_id"] in err and not run.exists()

@@ -100,3 +100,15 @@ def test_report_files(tmp_path: Path) -> None:
     rows = list(csv.DictReader((tmp_path / "report.csv").open()))
     assert rows[0]["pass"] == "True" and rows[1]["measured_x_m"] == ""
     assert float(rows[0]["measured_z_m"]) == pytest.approx(0.30001)
+
+
+def test_failed_creation_leaves_no_store(tmp_path: Path) -> None:
+    """Two planned holes with one id: refused as a StoreError, and no results.sqlite (nor any
+    temporary file) is left to block a new run."""
+    with pytest.raises(StoreError, match="nothing was written"):
+        Store.create(tmp_path, cell_name="c", cell_sha256="0", cell_text="", cell_path="",
+                     tour_text="{}", reference_text="", robot_model="m", port="p",
+                     holes=[("H1", 0, {}), ("H1", 1, {})])  # fmt: skip
+    assert list(tmp_path.iterdir()) == []
+    with _store(tmp_path) as s:
+        assert [h for h, _, _ in s.planned()] == ["H1", "H2"]
