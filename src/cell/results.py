@@ -7,6 +7,8 @@ surface; deviations in m; ``q_rad`` joints at capture (rad); ``temperatures_c`` 
 filled or rejected edge: a quality flag, whatever the deviations) or ``"missing"`` (no hole where
 one should be; no measured values). ``passed`` is the verdict against the tolerance from the
 deviations alone (True / False), None when the hole was not measured; a suspect hole keeps it.
+``thermal_model_id`` names the thermal model (row of the store's ``thermal_models``) the pose was
+compensated with; None: the nominal kinematics.
 """
 
 from __future__ import annotations
@@ -44,6 +46,7 @@ class HoleResult:
     measure_time_s: float = 0.0
     reason: str = ""
     passed: bool | None = None
+    thermal_model_id: int | None = None
     extra: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

@@ -15,7 +15,7 @@ import logging
 import sqlite3
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TypeVar
 
 import numpy as np
@@ -30,6 +30,7 @@ from cell.link.errors import LinkError, MoveTimeoutError, RequestRefusedError
 from cell.reference import target_of
 from cell.results import HoleResult
 from cell.store import Store
+from cell.thermal_record import remember_model, stored_model, stored_rows
 from cell.thermal_update import ThermalUpdate
 from measure import MeasurementError, head_frame, measure_hole
 from planner import Tour
@@ -139,6 +140,8 @@ class Runner:
         self.holes = {h.id: h for h in cell.holes_in_cell()}
         self.thermal = ThermalUpdate(cell, self.arm)
         self._T_head_left = invert(head_frame(camera.stereo))
+        self.model_id: int | None = None
+        self._round0 = 0
         self._loaded: Tour | None = None
         self._need_load = False
 
@@ -161,6 +164,7 @@ class Runner:
 
     def _run(self, result: RunResult, wait_for_start: Callable[[], None] | None) -> None:
         stored = self.store.stored_ids()
+        self._restore_thermal()
         self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
         if wait_for_start is not None:
             wait_for_start()
@@ -280,6 +284,18 @@ class Runner:
         time.sleep(self.options.settle_s)
         return self._call("status", self.client.status)
 
+    # --- thermal state in the store --------------------------------------------------------
+    def _restore_thermal(self) -> None:
+        """Reload the stored reference observations; use the given model (stored if new) or
+        else the model the run used last."""
+        self.thermal.rows = stored_rows(self.store)
+        self._round0 = 1 + max((r[5] for r in self.thermal.rows), default=-1)
+        if self.model is not None:
+            self.model_id = remember_model(self.store, self.model, "given (--thermal)")
+        elif (latest := stored_model(self.store)) is not None:
+            self.model_id, self.model = latest
+            self.store.event("thermal", f"continuing with stored thermal model {self.model_id}")
+
     # --- reference targets -----------------------------------------------------------------
     def _home_for_reference(self) -> None:
         """Bring the arm home along the inspection tour if it is elsewhere (a resumed run stopped
@@ -310,7 +326,9 @@ class Runner:
                     continue
                 p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
                 target = target_of(s.hole_id)
-                self.thermal.add(st.time_s, target, st.q_rad, st.temperatures_c, p_tcp, rnd)
+                row = (st.time_s, target, st.q_rad, st.temperatures_c, p_tcp, self._round0 + rnd)
+                self.store.record_reference(row[5], *row[:5])
+                self.thermal.add(*row)
                 self.progress("reference", {"round": rnd, "target": s.hole_id})
             self._move(len(tour.stops), "reference home")
             if rnd + 1 < self.options.reference_rounds:
@@ -330,6 +348,7 @@ class Runner:
         else:
             self.model = model
             r = self.thermal.result
+            self.model_id = remember_model(self.store, model, f"identified from {r.n_rows} rows")
             msg = (
                 f"thermal model identified from {r.n_rows} rows: terms {', '.join(r.report.kept)};"
                 f" residual {r.residual_rms_m * 1e6:.1f} um"
@@ -353,6 +372,7 @@ class Runner:
         result, meas = inspect_hole(self.cell, self.arm, self.model, self.camera.stereo,
                                self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
                                st.temperatures_c, st.time_s)  # fmt: skip
+        result = replace(result, thermal_model_id=self.model_id if self.model else None)
         clock.lap("inspect_s")
         self.store.record_hole(result)
         clock.lap("store_s")

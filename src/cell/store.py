@@ -4,7 +4,10 @@ Tables: ``meta`` (schema version), ``run`` (one row: cell name, SHA-256, text an
 cell file, the tour's and the reference tour's text, port, state, times), ``holes`` (every
 planned hole with its stop index and nominal geometry), ``measurements`` (at most one row per
 hole: a UNIQUE key makes storing a hole twice impossible), ``events`` (run state changes,
-faults, retries, thermal updates).
+faults, retries, thermal updates), ``reference_observations`` (every measured reference target:
+round, controller time, target, joints, readings, target in the TCP frame; one transaction each)
+and ``thermal_models`` (every thermal model the run used, as ``thermal.json`` text, with where
+it came from; a hole's result names the model it was compensated with, ``thermal_model_id``).
 
 A new store is built completely in a temporary file next to it and then renamed into place, so
 a failed creation leaves no half-made ``results.sqlite`` behind. Each hole is stored in one
@@ -22,13 +25,18 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from cell.errors import CellError
 from cell.results import HoleResult
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: versions :meth:`Store.open` can read; older ones get the tables added since (nothing removed)
+READABLE_VERSIONS = ("1", "2")
 FILENAME = "results.sqlite"
 
-_SCHEMA = """
+_SCHEMA = (
+    """
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE run (
     id INTEGER PRIMARY KEY CHECK (id = 1),
@@ -51,6 +59,20 @@ CREATE TABLE events (
     state TEXT NOT NULL, message TEXT NOT NULL, data_json TEXT NOT NULL
 );
 """
+    + """
+CREATE TABLE IF NOT EXISTS reference_observations (
+    id INTEGER PRIMARY KEY AUTOINCREMENT, round INTEGER NOT NULL, t_s REAL NOT NULL,
+    target TEXT NOT NULL, q_rad_json TEXT NOT NULL, temperatures_c_json TEXT NOT NULL,
+    p_tcp_m_json TEXT NOT NULL, stored_at REAL NOT NULL
+);
+CREATE TABLE IF NOT EXISTS thermal_models (
+    id INTEGER PRIMARY KEY AUTOINCREMENT, source TEXT NOT NULL, model_json TEXT NOT NULL,
+    stored_at REAL NOT NULL
+);
+"""
+)
+#: the tables added by schema version 2
+_SCHEMA_V2 = _SCHEMA[_SCHEMA.index("CREATE TABLE IF NOT EXISTS reference_observations") :]
 
 
 class StoreError(CellError):
@@ -111,16 +133,41 @@ class Store:
             raise StoreError(path, "no results store here (not a run directory)")
         try:
             con = sqlite3.connect(f"file:{path}?mode=rw", uri=True, isolation_level=None)
+        except sqlite3.Error as exc:
+            raise StoreError(path, f"cannot open the store ({exc}); not modified") from exc
+        try:
             check = con.execute("PRAGMA quick_check").fetchone()[0]
             if check != "ok":
                 raise StoreError(path, f"the store is corrupt ({check}); it was not modified")
             version = con.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()
+            if version is None or version[0] not in READABLE_VERSIONS:
+                found = None if version is None else version[0]
+                raise StoreError(path, f"schema version {found!r} is not one this holecell "
+                                       f"reads {READABLE_VERSIONS}; not modified")  # fmt: skip
         except sqlite3.DatabaseError as exc:
             raise StoreError(path, f"not a readable holecell store ({exc}); not modified") from exc
-        if version is None or version[0] != str(SCHEMA_VERSION):
-            raise StoreError(path, f"schema version {version} is not {SCHEMA_VERSION}")
-        con.close()
-        return cls(path, _connect(path))
+        finally:
+            con.close()
+        store = cls(path, _connect(path))
+        if version[0] != str(SCHEMA_VERSION):
+            store._upgrade()
+        return store
+
+    def _upgrade(self) -> None:
+        """Add the tables of the current schema to an older store (nothing is removed)."""
+        con = self._con
+        try:
+            con.execute("BEGIN")
+            for statement in _SCHEMA_V2.split(";"):
+                if statement.strip():
+                    con.execute(statement)
+            con.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'",
+                        (str(SCHEMA_VERSION),))  # fmt: skip
+            con.execute("COMMIT")
+        except BaseException:
+            con.execute("ROLLBACK")
+            con.close()
+            raise
 
     def close(self) -> None:
         """Close the database (checkpointing the WAL)."""
@@ -200,6 +247,46 @@ class Store:
                 self.path, f"hole {result.hole_id!r} is already stored or not planned ({exc})"
             ) from exc
 
+    # --- thermal ----------------------------------------------------------------------------
+    def record_reference(
+        self, round_index: int, t_s: float, target: str, q: Any, temps: Any, p_tcp: Any
+    ) -> None:
+        """Store one reference-target observation in one transaction (joints rad, readings
+        degC, target in the TCP frame m)."""
+        with self._con:
+            self._con.execute(
+                "INSERT INTO reference_observations (round, t_s, target, q_rad_json, "
+                "temperatures_c_json, p_tcp_m_json, stored_at) VALUES (?, ?, ?, ?, ?, ?, ?)",
+                (int(round_index), float(t_s), target, _floats(q), _floats(temps),
+                 _floats(p_tcp), time.time()),
+            )  # fmt: skip
+
+    def reference_observations(self) -> list[tuple[float, str, Any, Any, Any, int]]:
+        """Every stored observation as ``(t_s, target, q, temps, p_tcp, round)`` (numpy arrays),
+        in the order stored."""
+        rows = self._con.execute(
+            "SELECT t_s, target, q_rad_json, temperatures_c_json, p_tcp_m_json, round "
+            "FROM reference_observations ORDER BY id"
+        ).fetchall()
+        return [(t, tgt, np.array(json.loads(q)), np.array(json.loads(tc)),
+                 np.array(json.loads(p)), rnd) for t, tgt, q, tc, p, rnd in rows]  # fmt: skip
+
+    def record_model(self, source: str, model_text: str) -> int:
+        """Store a thermal model (``thermal.json`` text) the run uses from now; returns its id."""
+        with self._con:
+            cur = self._con.execute(
+                "INSERT INTO thermal_models (source, model_json, stored_at) VALUES (?, ?, ?)",
+                (source, model_text, time.time()),
+            )
+        return int(cur.lastrowid)
+
+    def latest_model(self) -> tuple[int, str, str] | None:
+        """``(id, source, thermal.json text)`` of the model stored last, or None."""
+        row = self._con.execute(
+            "SELECT id, source, model_json FROM thermal_models ORDER BY id DESC LIMIT 1"
+        ).fetchone()
+        return None if row is None else (int(row[0]), row[1], row[2])
+
     def results(self) -> list[HoleResult]:
         """Every stored hole, in stop order."""
         rows = self._con.execute(
@@ -216,6 +303,10 @@ class Store:
                 d["passed"] = None if d.get("center_part_m") is None else d["status"] != "fail"
             out.append(HoleResult(**d))
         return out
+
+
+def _floats(values: Any) -> str:
+    return json.dumps([float(v) for v in values])
 
 
 def _build(

@@ -112,3 +112,20 @@ def test_failed_creation_leaves_no_store(tmp_path: Path) -> None:
     assert list(tmp_path.iterdir()) == []
     with _store(tmp_path) as s:
         assert [h for h, _, _ in s.planned()] == ["H1", "H2"]
+
+
+def test_version_1_store_is_upgraded_without_loss(tmp_path: Path) -> None:
+    import sqlite3
+
+    with _store(tmp_path) as s:
+        s.record_hole(_result("H1", 0))
+    con = sqlite3.connect(tmp_path / "results.sqlite")
+    with con:
+        con.execute("DROP TABLE reference_observations")
+        con.execute("DROP TABLE thermal_models")
+        con.execute("UPDATE meta SET value = '1'")
+    con.close()
+    with Store.open(tmp_path) as s:
+        assert [r.hole_id for r in s.results()] == ["H1"]
+        s.record_reference(0, 1.0, "R1", [0.0] * 6, [20.0] * 6, [0.0, 0.0, 0.3])
+        assert s.record_model("given", "{}") == 1 and len(s.reference_observations()) == 1

@@ -1,0 +1,69 @@
+"""The run's thermal state lives in its store: every reference observation, every model used,
+and which model each hole was compensated with; a resumed run continues with them."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from cell_fixtures import SmallCell
+
+from cell.link.client import ControllerClient, LinkOptions
+from cell.run_setup import resume_run, start_run
+from cell.runner import Runner, RunOptions
+from cell.sim.session import SimCell
+from cell.sim.world import WorldOptions
+from cell.store import Store
+
+FAST_LINK = LinkOptions(response_timeout_s=0.05, retries=20, heartbeat_period_s=0.1)
+
+
+def _run(sc: SmallCell, run_dir: Path, sim: SimCell, rounds: int, resume: bool, progress=None):
+    if resume:
+        files = resume_run(run_dir)
+    else:
+        files = start_run(run_dir, sc.cell, sc.tour, "tour.json", sim.url, sc.reference)
+    options = RunOptions(settle_s=0.0, reference_rounds=rounds)
+    try:
+        with ControllerClient(sim.url, FAST_LINK) as client:
+            return Runner(files.cell, files.tour, files.store, client, sim.camera, options,
+                          files.reference, progress=progress).run()  # fmt: skip
+    finally:
+        files.store.close()
+
+
+def _stop_after_first_hole(event: str, data: dict) -> None:
+    if event == "hole":
+        raise KeyboardInterrupt
+
+
+def _interrupted(sc: SmallCell, run_dir: Path, sim: SimCell, rounds: int, resume: bool) -> None:
+    try:
+        _run(sc, run_dir, sim, rounds, resume, _stop_after_first_hole)
+    except KeyboardInterrupt:
+        return
+    raise AssertionError("the run was not interrupted")
+
+
+def test_observations_and_model_are_stored_and_reloaded(
+    small_cell: SmallCell, tmp_path: Path
+) -> None:
+    with SimCell.start(small_cell.cell, WorldOptions(speed=1500.0, drift_offset_s=0.0)) as sim:
+        _interrupted(small_cell, tmp_path, sim, 2, False)
+        with Store.open(tmp_path) as store:
+            n_obs = len(store.reference_observations())
+            model_id, source, text = store.latest_model()
+        assert n_obs >= 2 * len(small_cell.reference.stops) - 2
+        assert "identified" in source and json.loads(text)["format"] == "holecell.thermal/1"
+        # resumed without reference rounds: the stored model compensates the next hole
+        _interrupted(small_cell, tmp_path, sim, 0, True)
+        # one more round: identified from the stored rows and the new ones together
+        result = _run(small_cell, tmp_path, sim, 1, True)
+    assert result.status == "done"
+    with Store.open(tmp_path) as store:
+        obs = store.reference_observations()
+        used = [r.thermal_model_id for r in store.results()]
+        last_id = store.latest_model()[0]
+    assert sorted({r[5] for r in obs}) == [0, 1, 2]
+    assert f"identified from {len(obs)} rows" in result.thermal
+    assert used == [model_id, model_id, last_id] and last_id != model_id
