@@ -33,6 +33,7 @@ from robots.thermal import (
     reference_from_cold,
     simulate_observations,
 )
+from robots.thermal.compensate import compensated_T_cell_tcp
 from robots.thermal.csvio import read_observations, read_poses, write_observations
 from robots.thermal.errors import ThermalDataError
 from robots.thermal.modelfile import load_model, save_model
@@ -222,12 +223,14 @@ def run_predict(args: argparse.Namespace) -> int:
     used = tuple(dict.fromkeys(names[i] for i in model.spec.sensor_of_link))
     poses = read_poses(args.poses, names, used)
     _check_joint_limits(args.poses, model.robot_model, poses.q_rad)
-    T_cell_tcp = model.T_cell_base @ model.fk(poses.q_rad, poses.temps_degC) @ model.T_tool0_tcp
-    nominal = model.T_cell_base @ model.fk(
-        poses.q_rad, np.broadcast_to(model.spec.reference_degC, poses.temps_degC.shape)
+    # the model file's own base and tool: predict needs no cell file
+    T_cell_tcp = compensated_T_cell_tcp(
+        model, model.T_cell_base, model.T_tool0_tcp, poses.q_rad, poses.temps_degC
     )
+    cold = np.broadcast_to(model.spec.reference_degC, poses.temps_degC.shape)
+    nominal = compensated_T_cell_tcp(model, model.T_cell_base, model.T_tool0_tcp, poses.q_rad, cold)
     p = T_cell_tcp[:, :3, 3]
-    drift = p - (nominal @ model.T_tool0_tcp)[:, :3, 3]
+    drift = p - nominal[:, :3, 3]
     header = list(poses.header) + list(PREDICT_COLUMNS)
     cmds = []
     if args.joint_command:
