@@ -111,13 +111,17 @@ def start_run(
 def resume_run(run_dir: str | Path) -> RunFiles:
     """Reopen ``run_dir``: the cell and tours come from its store, checked again."""
     store = Store.open(run_dir)
-    info = store.run_info()
-    where = f"{store.path}"
-    path = Path(info["cell_path"]) if info["cell_path"] else None
-    cell = parse_cell(info["cell_text"], f"{where} (cell)", path)
-    tour = tour_from_dict(json.loads(info["tour_text"]), f"{where} (tour)")
-    reference = None
-    if info["reference_text"]:
-        reference = tour_from_dict(json.loads(info["reference_text"]), f"{where} (reference)")
-    check_tour(tour, cell, f"{where} (tour)")
+    try:
+        info = store.run_info()
+        where = f"{store.path}"
+        path = Path(info["cell_path"]) if info["cell_path"] else None
+        cell = parse_cell(info["cell_text"], f"{where} (cell)", path)
+        tour = tour_from_dict(json.loads(info["tour_text"]), f"{where} (tour)")
+        reference = None
+        if info["reference_text"]:
+            reference = tour_from_dict(json.loads(info["reference_text"]), f"{where} (reference)")
+        check_tour(tour, cell, f"{where} (tour)")
+    except BaseException:
+        store.close()
+        raise
     return RunFiles(cell, tour, reference, store)

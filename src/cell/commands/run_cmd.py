@@ -87,13 +87,10 @@ def _prepare(
     if args.resume:
         if args.tour or args.cell:
             raise CellError("--resume takes the cell and tour from the run; give neither")
-        files = resume_run(args.resume)
-        try:
-            model = _thermal_model(args.thermal, files.cell)
-        except BaseException:
-            files.store.close()
-            raise
-        return files.cell, model, lambda: files
+        files = resume_run(args.resume)  # checked now, reopened once the cell answers
+        files.store.close()
+        model = _thermal_model(args.thermal, files.cell)
+        return files.cell, model, lambda: resume_run(args.resume)
     if not args.tour or not args.cell:
         raise CellError("give TOUR and --cell CELL (or --resume RUN_DIR)")
     cell = load_cell(args.cell)

@@ -54,11 +54,17 @@ class SimServer:
         self._dead_until = 0.0
         self._listener: socket.socket | None = None
         self._conn: socket.socket | None = None
+        self._closed = False
         if transport == "pty":
             self._master, self._slave = os.openpty()
-            tty.setraw(self._slave)
-            os.set_blocking(self._master, False)
-            self.url = os.ttyname(self._slave)
+            try:
+                tty.setraw(self._slave)
+                os.set_blocking(self._master, False)
+                self.url = os.ttyname(self._slave)
+            except BaseException:
+                os.close(self._master)
+                os.close(self._slave)
+                raise
         else:
             self._listener = socket.create_server(("127.0.0.1", 0))
             self._listener.setblocking(False)
@@ -73,10 +79,13 @@ class SimServer:
         return self
 
     def close(self) -> None:
-        """Stop serving and release the pty or socket."""
+        """Stop serving and release the pty or socket; closing again does nothing."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=2.0)
+        if self._closed:
+            return
+        self._closed = True
         if self.transport == "pty":
             for fd in (self._master, self._slave):
                 os.close(fd)

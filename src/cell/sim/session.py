@@ -49,7 +49,11 @@ class SimCell:
             link_timeout_s=link_timeout_s,
         )
         server = SimServer(ctrl, faults, transport).start()
-        cam = SimCamera(w, ctrl, cell_stereo(cell), faults.missing_holes, render, faults.seed)
+        try:
+            cam = SimCamera(w, ctrl, cell_stereo(cell), faults.missing_holes, render, faults.seed)
+        except BaseException:
+            server.close()
+            raise
         return cls(w, ctrl, server, cam)
 
     @property
