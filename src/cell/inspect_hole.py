@@ -10,6 +10,7 @@ nominal kinematics without a model); ``T_cell_part`` from the cell file.
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
@@ -47,38 +48,67 @@ def inspect_hole(
     sim_time_s: float,
 ) -> tuple[HoleResult, HoleMeasurement | None]:
     """Measure ``hole`` from one pair and compare it with its nominal; never raises for a hole
-    that is not there or cannot be measured (that is a result: ``missing``)."""
+    that is not there (``missing``) or cannot be measured (``unmeasured``: a resume retries
+    it)."""
     T_part_cell = invert(cell.T_cell_part())
     nominal = T_part_cell[:3, :3] @ hole.position_m + T_part_cell[:3, 3]
-    base = {
+    base = _base_fields(hole, stop_index, nominal, q_rad, temps_c, sim_time_s)
+    t0 = time.perf_counter()
+    try:
+        meas = measure_hole(left, right, stereo, expected_diameter_m=hole.diameter_m)
+    except HoleNotFoundError as exc:
+        return HoleResult(status="missing", reason=f"no hole found: {exc}", **base), None
+    except MeasurementError as exc:
+        return HoleResult(status="unmeasured", reason=f"not measurable: {exc}", **base), None
+    t_meas = time.perf_counter() - t0
+    T_head_left = invert(head_frame(stereo))
+    T_part_left = T_part_cell @ T_cell_tcp(arm, model, q_rad, temps_c) @ T_head_left
+    T_nom = T_part_cell @ arm.fk(q_rad, "tcp") @ T_head_left
+    center_nominal_fk = T_nom[:3, :3] @ meas.center_m + T_nom[:3, 3]
+    extra = {"center_part_uncompensated_m": [float(v) for v in center_nominal_fk]}
+    return _measured(meas, T_part_left, hole, nominal, t_meas, extra, base), meas
+
+
+def _base_fields(
+    hole: HoleInCell,
+    stop_index: int,
+    nominal_part_m: np.ndarray,
+    q_rad: np.ndarray,
+    temps_c: np.ndarray,
+    sim_time_s: float,
+) -> dict[str, Any]:
+    """The fields of a result that do not depend on the measurement."""
+    return {
         "hole_id": hole.id,
         "stop_index": stop_index,
-        "nominal_part_m": tuple(float(v) for v in nominal),
+        "nominal_part_m": tuple(float(v) for v in nominal_part_m),
         "nominal_diameter_m": float(hole.diameter_m),
         "tolerance_m": hole.tolerance_m,
         "q_rad": tuple(float(v) for v in q_rad),
         "temperatures_c": tuple(float(v) for v in temps_c),
         "sim_time_s": float(sim_time_s),
     }
-    t0 = time.perf_counter()
-    try:
-        meas = measure_hole(left, right, stereo, expected_diameter_m=hole.diameter_m)
-    except MeasurementError as exc:
-        kind = "no hole found" if isinstance(exc, HoleNotFoundError) else "not measurable"
-        reason = f"{kind}: {exc}"
-        return HoleResult(status="missing", reason=reason, **base), None
-    t_meas = time.perf_counter() - t0
-    T_head_left = invert(head_frame(stereo))
-    T_part_left = T_part_cell @ T_cell_tcp(arm, model, q_rad, temps_c) @ T_head_left
+
+
+def _measured(
+    meas: HoleMeasurement,
+    T_part_left: np.ndarray,
+    hole: HoleInCell,
+    nominal_part_m: np.ndarray,
+    measure_time_s: float,
+    extra: dict[str, Any],
+    base: dict[str, Any],
+) -> HoleResult:
+    """The result of a measured hole: centre and axis carried into the part frame by
+    ``T_part_left``, deviations and the verdict against the tolerance; ``suspect`` flags a
+    measurement of doubtful quality whatever the verdict."""
     center = T_part_left[:3, :3] @ meas.center_m + T_part_left[:3, 3]
     normal = T_part_left[:3, :3] @ meas.normal
-    T_nom = T_part_cell @ arm.fk(q_rad, "tcp") @ T_head_left
-    center_nominal_fk = T_nom[:3, :3] @ meas.center_m + T_nom[:3, 3]
-    dpos, ddia, ok = deviations(center, meas.diameter_m, nominal, hole.diameter_m, hole.tolerance_m)
+    dpos, ddia, ok = deviations(center, meas.diameter_m, nominal_part_m, hole.diameter_m,
+                                hole.tolerance_m)  # fmt: skip
     cov = np.asarray(meas.cov_center_radius, float)
-    status = "suspect" if meas.status == "suspect" else ("ok" if ok else "fail")
-    result = HoleResult(
-        status=status,
+    return HoleResult(
+        status="suspect" if meas.status == "suspect" else ("ok" if ok else "fail"),
         passed=ok,
         center_part_m=tuple(float(v) for v in center),
         normal_part=tuple(float(v) for v in normal),
@@ -89,8 +119,7 @@ def inspect_hole(
         u_diameter_m=float(2.0 * np.sqrt(max(cov[3, 3], 0.0))),
         rms_m=float(meas.rms_m),
         n_points=int(meas.n_points),
-        measure_time_s=t_meas,
-        extra={"center_part_uncompensated_m": [float(v) for v in center_nominal_fk]},
+        measure_time_s=measure_time_s,
+        extra=extra,
         **base,
     )
-    return result, meas

@@ -42,6 +42,7 @@ def summary(store: Store) -> dict[str, Any]:
         "holes_stored": len(results),
         "holes_measured": len(measured),
         "holes_missing": sum(r.status == "missing" for r in results),
+        "holes_unmeasured": sum(r.status == "unmeasured" for r in results),
         "holes_failed": sum(r.passed is False for r in results),
         "holes_suspect": sum(r.status == "suspect" for r in results),
         "holes_not_reached": len(planned) - len(results),
@@ -102,6 +103,7 @@ def format_summary(summ: dict[str, Any]) -> str:
         f"cell            {summ['cell']} ({summ['robot_model']})",
         f"run state       {summ['state']}",
         f"holes           {summ['holes_measured']} measured, {summ['holes_missing']} missing, "
+        f"{summ['holes_unmeasured']} not measurable, "
         f"{summ['holes_failed']} out of tolerance, {summ['holes_suspect']} suspect, "
         f"{summ['holes_not_reached']} not reached "
         f"(of {summ['holes_planned']} planned)",

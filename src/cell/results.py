@@ -4,9 +4,11 @@ Frames and units: ``*_part_m`` in the part frame (m); ``normal_part`` unit axis 
 surface; deviations in m; ``q_rad`` joints at capture (rad); ``temperatures_c`` sensor readings
 (degC); times in s. ``status`` is ``"ok"`` (measured, within tolerance or no tolerance),
 ``"fail"`` (measured, out of tolerance), ``"suspect"`` (measured, but the measurement flags much
-filled or rejected edge: a quality flag, whatever the deviations) or ``"missing"`` (no hole where
-one should be; no measured values). ``passed`` is the verdict against the tolerance from the
-deviations alone (True / False), None when the hole was not measured; a suspect hole keeps it.
+filled or rejected edge: a quality flag, whatever the deviations), ``"missing"`` (no hole where
+one should be; no measured values) or ``"unmeasured"`` (a hole was seen but could not be measured;
+no measured values; a resumed run tries it again). ``passed`` is the verdict against the
+tolerance from the deviations alone (True / False), None when the hole was not measured; a
+suspect hole keeps it.
 ``thermal_model_id`` names the thermal model (row of the store's ``thermal_models``) the pose was
 compensated with; None: the nominal kinematics.
 """
@@ -18,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-STATUSES = ("ok", "fail", "suspect", "missing")
+STATUSES = ("ok", "fail", "suspect", "missing", "unmeasured")
 
 
 @dataclass(frozen=True)

@@ -163,7 +163,7 @@ class Runner:
         return result
 
     def _run(self, result: RunResult, wait_for_start: Callable[[], None] | None) -> None:
-        stored = self.store.stored_ids()
+        stored = self.store.done_ids()
         self._restore_thermal()
         self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
         if wait_for_start is not None:

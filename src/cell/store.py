@@ -228,20 +228,31 @@ class Store:
         """Ids of the holes already stored."""
         return {r[0] for r in self._con.execute("SELECT hole_id FROM measurements")}
 
+    def done_ids(self) -> set[str]:
+        """Ids of the holes stored with a final result (every status but ``unmeasured``, which
+        a resumed run tries again)."""
+        rows = self._con.execute("SELECT hole_id FROM measurements WHERE status != 'unmeasured'")
+        return {r[0] for r in rows}
+
     def record_hole(self, result: HoleResult) -> None:
-        """Store one hole in one transaction; storing a hole twice raises :class:`StoreError`."""
+        """Store one hole in one transaction. A hole stored as ``unmeasured`` is replaced by a
+        new attempt (the earlier attempt is kept as a ``retry`` event); storing any other hole
+        twice raises :class:`StoreError`."""
+        row = (result.hole_id, result.stop_index, result.status, json.dumps(result.to_dict()),
+               time.time())  # fmt: skip
         try:
             with self._con:
-                self._con.execute(
-                    "INSERT INTO measurements VALUES (?, ?, ?, ?, ?)",
-                    (
-                        result.hole_id,
-                        result.stop_index,
-                        result.status,
-                        json.dumps(result.to_dict()),
-                        time.time(),
-                    ),
-                )
+                old = self._con.execute(
+                    "SELECT result_json FROM measurements WHERE hole_id = ? AND "
+                    "status = 'unmeasured'", (result.hole_id,)
+                ).fetchone()  # fmt: skip
+                if old is not None:
+                    self._insert_event("retry", self.run_info()["state"],
+                                       f"hole {result.hole_id}: earlier attempt unmeasured",
+                                       json.loads(old[0]))  # fmt: skip
+                    self._con.execute("DELETE FROM measurements WHERE hole_id = ?",
+                                      (result.hole_id,))  # fmt: skip
+                self._con.execute("INSERT INTO measurements VALUES (?, ?, ?, ?, ?)", row)
         except sqlite3.IntegrityError as exc:
             raise StoreError(
                 self.path, f"hole {result.hole_id!r} is already stored or not planned ({exc})"

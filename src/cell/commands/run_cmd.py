@@ -162,7 +162,7 @@ def run_run(args: argparse.Namespace) -> int:
         camera = NetworkCamera(args.camera, cell_stereo(cell))
         files = open_files()
         run_dir = files.store.path.parent
-        stored = len(files.store.stored_ids())
+        stored = len(files.store.done_ids())
         options = RunOptions(
             settle_s=args.settle_s,
             reference_rounds=args.reference_rounds,
