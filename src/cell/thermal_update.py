@@ -9,7 +9,7 @@ one reading as a sensor shared by every link; other counts are refused.
 
 The reference temperatures (where the nominal D-H table holds) follow the rule of
 ``holecell thermal identify`` (:func:`robots.thermal.identify.reference_from_cold`): the
-readings of the cold state, here the per-sensor mean of the first reference round's readings.
+readings of the cold state, here those of the first reference round's earliest observation.
 """
 
 from __future__ import annotations
@@ -76,9 +76,12 @@ class ThermalUpdate:
         )
 
     def reference_degC(self) -> tuple[float, ...]:
-        """Per-sensor mean reading (degC) of the first round observed: the cold state."""
+        """Per-sensor reading (degC) of the cold state: the earliest observation of the first
+        reference round (the mean of the rows at that time), as
+        :func:`robots.thermal.identify.reference_from_cold` takes it from a file."""
         first = min(r[5] for r in self.rows)
-        temps = np.array([r[3] for r in self.rows if r[5] == first])
+        t0 = min(r[0] for r in self.rows if r[5] == first)
+        temps = np.array([r[3] for r in self.rows if r[5] == first and r[0] == t0])
         return tuple(float(v) for v in temps.mean(axis=0))
 
     def observations(self) -> Observations:
