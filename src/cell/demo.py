@@ -20,12 +20,12 @@ from typing import Any
 
 import numpy as np
 
-from cell.config import load_builtin_cell
+from cell.config import CellConfig, load_builtin_cell
 from cell.link.client import ControllerClient
 from cell.reference import plan_reference_tour
 from cell.report import write_report
 from cell.results import HoleResult
-from cell.run_setup import start_run
+from cell.run_setup import RunFiles, check_new_run_dir, start_run
 from cell.runner import Progress, Runner, RunOptions, RunResult
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
@@ -104,6 +104,19 @@ def _plan_reference(seed: int) -> dict[str, Any]:
     return plan_reference_tour(load_builtin_cell(), Options(seed=seed)).to_dict()
 
 
+def plan_demo(
+    cell: CellConfig, seed: int, plan_progress: Callable[[str, int, int], None] | None = None
+) -> tuple[Tour, Tour]:
+    """The hole tour and the reference tour of ``cell``; the reference tour is planned in a
+    second process while this one plans the holes."""
+    ctx = multiprocessing.get_context("fork")
+    with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
+        ref_job = pool.submit(_plan_reference, seed)
+        tour = TourPlanner(Options(seed=seed), plan_progress).plan(cell)
+        reference = tour_from_dict(ref_job.result(), "reference tour")
+    return tour, reference
+
+
 def run_demo(
     out_dir: str | Path,
     options: DemoOptions | None = None,
@@ -111,49 +124,54 @@ def run_demo(
     run_progress: Progress | None = None,
     recorder_factory: Callable[..., Any] | None = None,
 ) -> DemoResult:
-    """Plan, run and report the built-in cell in ``out_dir`` (created; must not hold a run)."""
+    """Plan, run and report the built-in cell in ``out_dir`` (created; refused before planning
+    if it is a file or holds a run already)."""
+    check_new_run_dir(out_dir, resumable=False)
     opts = options or DemoOptions()
     t0 = time.perf_counter()
     cell = load_builtin_cell()
-    # the reference tour is planned in a second process while this one plans the holes
-    ctx = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
-        ref_job = pool.submit(_plan_reference, opts.seed)
-        tour = TourPlanner(Options(seed=opts.seed), plan_progress).plan(cell)
-        reference = tour_from_dict(ref_job.result(), "reference tour")
+    tour, reference = plan_demo(cell, opts.seed, plan_progress)
     t_plan = time.perf_counter() - t0
     world = WorldOptions(speed=opts.warmup_speed, drift_offset_s=0.0, seed=opts.seed)
     with SimCell.start(cell, world, opts.faults) as sim:
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
-
-        def progress(event: str, data: dict) -> None:
-            if event == "state" and data["state"] == "inspecting":
-                sim.world.clock.set_speed(opts.run_speed)
-            if run_progress is not None:
-                run_progress(event, data)
-
-        run_opts = RunOptions(
-            settle_s=0.2 / opts.run_speed,
-            reference_rounds=opts.reference_rounds,
-            reference_interval_s=opts.reference_interval_s,
-        )
-        client = ControllerClient(sim.url)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
         try:
-            client.connect()
-            runner = Runner(cell, tour, files.store, client, sim.camera, run_opts, reference,
-                            None, progress, recorder)  # fmt: skip
-            result = runner.run()
+            result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder)
             truth = truth_error(sim.world, files.store.results())
         finally:
-            client.close()
             files.store.close()
             if recorder is not None:
                 recorder.close()
     summary = write_report(out_dir)
-    timings = {
-        "plan_s": t_plan,
-        "run_s": result.timings["run_s"],
-        "total_s": time.perf_counter() - t0,
-    }
+    timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
+               "total_s": time.perf_counter() - t0}  # fmt: skip
     return DemoResult(Path(out_dir), tour, result, summary, truth, timings)
+
+
+def _speed_up(sim: SimCell, opts: DemoOptions, run_progress: Progress | None) -> Progress:
+    """Progress that switches the simulation from the warm-up speed to the run speed once the
+    holes are measured, and passes every event on."""
+
+    def progress(event: str, data: dict) -> None:
+        if event == "state" and data["state"] == "inspecting":
+            sim.world.clock.set_speed(opts.run_speed)
+        if run_progress is not None:
+            run_progress(event, data)
+
+    return progress
+
+
+def _run_sim(
+    sim: SimCell, files: RunFiles, opts: DemoOptions, progress: Progress, recorder: Any
+) -> RunResult:
+    """Run the stored tour on the simulated cell over its port."""
+    run_opts = RunOptions(
+        settle_s=0.2 / opts.run_speed,
+        reference_rounds=opts.reference_rounds,
+        reference_interval_s=opts.reference_interval_s,
+    )
+    with ControllerClient(sim.url) as client:
+        runner = Runner(files.cell, files.tour, files.store, client, sim.camera, run_opts,
+                        files.reference, None, progress, recorder)  # fmt: skip
+        return runner.run()

@@ -9,6 +9,8 @@ view becomes a pseudo-hole ``"<target>#<view>"`` whose normal is the reversed vi
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from cell.config import CellConfig, Hole
@@ -18,6 +20,9 @@ from robots.thermal.plan import ViewOptions, view_pose
 from robots.transforms import invert
 
 VIEW_SEPARATOR = "#"
+#: the logger the planner reports left-out holes on
+PLANNER_LOGGER = "planner.planner"
+log = logging.getLogger(__name__)
 
 
 def target_of(stop_id: str) -> str:
@@ -53,8 +58,26 @@ def reference_cell(cell: CellConfig, views: ViewOptions | None = None) -> CellCo
     return cell.model_copy(update={"name": f"{cell.name}:reference", "part": part})
 
 
+class _LeftOutViews(logging.Filter):
+    """Holds back the planner's warnings about left-out holes while a reference tour is planned:
+    views the arm cannot take are expected there (the tour lists them in ``left_out``)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "left out" not in record.getMessage()
+
+
 def plan_reference_tour(
     cell: CellConfig, options: Options | None = None, views: ViewOptions | None = None
 ) -> Tour:
-    """Plan the tour home -> every reachable view of every reference target -> home."""
-    return plan_tour(reference_cell(cell, views), options or Options())
+    """Plan the tour home -> every reachable view of every reference target -> home. Views
+    left out (unreachable, in collision) are logged at INFO, not as warnings: the other views
+    of the target serve."""
+    planner_log, quiet = logging.getLogger(PLANNER_LOGGER), _LeftOutViews()
+    planner_log.addFilter(quiet)
+    try:
+        tour = plan_tour(reference_cell(cell, views), options or Options())
+    finally:
+        planner_log.removeFilter(quiet)
+    for h in tour.left_out:
+        log.info("reference view %s left out: %s", h.hole_id, h.reason)
+    return tour

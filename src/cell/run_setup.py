@@ -17,7 +17,7 @@ import numpy as np
 from cell.config import CellConfig, parse_cell
 from cell.errors import CellError
 from cell.runner import stop_rows
-from cell.store import Store
+from cell.store import FILENAME, Store
 from planner import Tour, TourCellMismatchError, check_tour_for_cell
 from planner.planner import cell_sha256
 from planner.tour import tour_from_dict
@@ -63,6 +63,18 @@ def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False
         if unknown:
             raise CellError(f"{where}: stops.hole_id: holes the cell does not have: {unknown[:5]}")
     stop_rows(tour)
+
+
+def check_new_run_dir(out: str | Path, resumable: bool = True) -> None:
+    """Refuse ``out`` as the directory of a new run when it is a file or holds a run already
+    (checked before anything is planned, connected or written). ``resumable``: the command can
+    continue a stored run (``holecell run --resume``), so the message says so."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise CellError(f"--out {out}: exists and is not a directory; give a new directory")
+    if (out / FILENAME).exists():
+        hint = f"continue it with holecell run --resume {out}, or " if resumable else ""
+        raise CellError(f"--out {out}: a run is stored here already; {hint}give another --out")
 
 
 @dataclass

@@ -17,7 +17,7 @@ from cell.link.client import ControllerClient
 from cell.record import Recorder
 from cell.reference import plan_reference_tour
 from cell.report import format_summary, write_report
-from cell.run_setup import RunFiles, check_tour, resume_run, start_run
+from cell.run_setup import RunFiles, check_new_run_dir, check_tour, resume_run, start_run
 from cell.runner import Runner, RunOptions
 from cell.thermal_check import check_model_for_cell, check_model_sensors
 from planner import load_tour
@@ -93,6 +93,8 @@ def _prepare(
         return files.cell, model, lambda: resume_run(args.resume)
     if not args.tour or not args.cell:
         raise CellError("give TOUR and --cell CELL (or --resume RUN_DIR)")
+    out = Path(args.out) if args.out else Path("runs") / Path(args.tour).stem
+    check_new_run_dir(out)
     cell = load_cell(args.cell)
     tour = load_tour(args.tour)
     check_tour(tour, cell, args.tour)
@@ -100,7 +102,6 @@ def _prepare(
     reference = (
         plan_reference_tour(cell) if cell.reference_targets and args.reference_rounds else None
     )
-    out = Path(args.out) if args.out else Path("runs") / Path(args.tour).stem
     return cell, model, lambda: start_run(out, cell, tour, args.tour, args.port, reference)
 
 

@@ -10,7 +10,14 @@ from __future__ import annotations
 import argparse
 import time
 
+from cell.commands.argtypes import (
+    non_negative_float,
+    non_negative_int,
+    positive_float,
+    probability,
+)
 from cell.config import load_cell
+from cell.errors import CellError
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
@@ -30,22 +37,40 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
     p.add_argument("--transport", choices=("pty", "socket"), default="pty")
-    p.add_argument("--speed", type=float, default=1.0, help="simulation speed (x real time)")
-    p.add_argument("--drift-offset-s", type=float, default=0.0, help="warm-up already elapsed")
-    p.add_argument("--drop", type=float, default=0.0, help="probability a frame is lost")
-    p.add_argument("--corrupt", type=float, default=0.0, help="probability of a flipped bit")
-    p.add_argument("--delay", type=float, default=0.0, help="probability an answer is late")
-    p.add_argument("--disconnect-after", type=int, default=None, help="requests, then cut")
-    p.add_argument("--estop-at", type=int, default=None, help="e-stop on arrival at stop K")
-    p.add_argument("--missing", nargs="*", default=(), help="hole ids that are not there")
+    p.add_argument(
+        "--speed", type=positive_float, default=1.0, help="simulation speed (x real time, > 0)"
+    )
+    p.add_argument(
+        "--drift-offset-s", type=non_negative_float, default=0.0, help="warm-up already elapsed (s)"
+    )
+    p.add_argument("--drop", type=probability, default=0.0, help="probability a frame is lost")
+    p.add_argument("--corrupt", type=probability, default=0.0, help="probability of a flipped bit")
+    p.add_argument("--delay", type=probability, default=0.0, help="probability an answer is late")
+    p.add_argument(
+        "--disconnect-after", type=non_negative_int, default=None, help="requests, then cut"
+    )
+    p.add_argument(
+        "--estop-at",
+        type=non_negative_int,
+        default=None,
+        help="e-stop on arrival at stop K (0-based)",
+    )
+    p.add_argument(
+        "--missing", nargs="*", default=(), help="hole ids (of the cell) that are not there"
+    )
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--duration-s", type=float, default=None, help="stop after this long")
+    p.add_argument("--duration-s", type=positive_float, default=None, help="stop after this long")
     p.set_defaults(handler=run_sim)
 
 
 def run_sim(args: argparse.Namespace) -> int:
     """Handler of ``holecell sim``."""
     cell = load_cell(args.cell)
+    known = {h.id for h in cell.part.holes}
+    unknown = [h for h in args.missing if h not in known]
+    if unknown:
+        raise CellError(f"--missing: {cell.name} has no hole {', '.join(unknown)} "
+                        f"(holes: {', '.join(sorted(known)[:8])}...)")  # fmt: skip
     faults = FaultPlan(
         drop=args.drop,
         corrupt=args.corrupt,

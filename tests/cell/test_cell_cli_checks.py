@@ -1,0 +1,66 @@
+"""Command-line mistakes are refused at once with a clear message, before anything is planned,
+connected or written; the reference tour's left-out views are not warnings."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import pytest
+from cell_fixtures import SmallCell
+
+from cell.cli import main
+from cell.reference import plan_reference_tour
+from planner import Options
+
+
+def _run(sc: SmallCell, out: Path) -> list[str]:
+    return ["run", str(sc.tour_path), "--cell", str(sc.path), "--out", str(out),
+            "--port", "/nonexistent/port", "--camera", "tcp://127.0.0.1:1"]  # fmt: skip
+
+
+def test_run_out_is_a_file(small_cell: SmallCell, tmp_path: Path, capsys) -> None:
+    out = tmp_path / "a_file"
+    out.write_text("keep me")
+    assert main(_run(small_cell, out)) == 2
+    err = capsys.readouterr().err
+    assert "a_file" in err and "not a directory" in err and "/nonexistent/port" not in err
+    assert out.read_text() == "keep me"
+
+
+def test_run_out_holds_a_run(small_cell: SmallCell, tmp_path: Path, capsys) -> None:
+    (tmp_path / "results.sqlite").write_bytes(b"stored run")
+    assert main(_run(small_cell, tmp_path)) == 2
+    err = capsys.readouterr().err
+    assert "stored here already" in err and f"--resume {tmp_path}" in err
+
+
+def test_demo_out_holds_a_run_refused_before_planning(tmp_path: Path, capsys) -> None:
+    (tmp_path / "results.sqlite").write_bytes(b"stored run")
+    assert main(["demo", "--out", str(tmp_path), "--quiet", "--no-record"]) == 2
+    err = capsys.readouterr().err
+    assert "stored here already" in err and "another --out" in err and "--resume" not in err
+    assert (tmp_path / "results.sqlite").read_bytes() == b"stored run"
+
+
+@pytest.mark.parametrize("argv", [["--speed", "0"], ["--speed", "-1"], ["--speed", "inf"],
+                                  ["--estop-at", "-3"], ["--drop", "1.5"]])  # fmt: skip
+def test_sim_refuses_bad_numbers(argv: list[str], capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["sim", *argv, "--duration-s", "0.1"])
+    assert exc.value.code == 2 and argv[0] in capsys.readouterr().err
+
+
+def test_sim_refuses_an_unknown_missing_hole(small_cell: SmallCell, capsys) -> None:
+    code = main(["sim", str(small_cell.path), "--missing", "NOPE", "--duration-s", "0.1"])
+    err = capsys.readouterr().err
+    assert code == 2 and "NOPE" in err and "--missing" in err and "Traceback" not in err
+
+
+def test_reference_views_left_out_are_info(small_cell: SmallCell, caplog) -> None:
+    with caplog.at_level(logging.INFO):
+        tour = plan_reference_tour(small_cell.cell, Options(seed=1))
+    assert tour.left_out, "the small cell's reference tour leaves a view out"
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+    left = [r for r in caplog.records if "left out" in r.getMessage()]
+    assert left and all(r.levelno == logging.INFO for r in left)
