@@ -1,8 +1,9 @@
 """The whole job on the built-in cell with the simulated controller and cameras.
 
 Plan the tour of the built-in motorcycle frame (and the reference-target tour), start the
-simulated cell on a pseudo-terminal with a cold arm, let the runner measure the reference targets
-while the arm warms up (the simulation fast-forwards the warm-up at ``warmup_speed``), identify
+simulated cell on a pseudo-terminal with a cold arm (in real time), let the runner take the cold
+readings and measure the reference targets while the arm warms up (from the first round on, the
+simulation fast-forwards the warm-up at ``warmup_speed``), identify
 the thermal model, then measure every hole at ``run_speed``. Since the simulation knows the
 truth, the result also holds the measurement error against it, with and without compensation.
 """
@@ -132,7 +133,8 @@ def run_demo(
     cell = load_builtin_cell()
     tour, reference = plan_demo(cell, opts.seed, plan_progress)
     t_plan = time.perf_counter() - t0
-    world = WorldOptions(speed=opts.warmup_speed, drift_offset_s=0.0, seed=opts.seed)
+    # real time until the first reference round starts (its readings are the cold state)
+    world = WorldOptions(speed=1.0, drift_offset_s=0.0, seed=opts.seed)
     with SimCell.start(cell, world, opts.faults) as sim:
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
@@ -150,10 +152,13 @@ def run_demo(
 
 
 def _speed_up(sim: SimCell, opts: DemoOptions, run_progress: Progress | None) -> Progress:
-    """Progress that switches the simulation from the warm-up speed to the run speed once the
-    holes are measured, and passes every event on."""
+    """Progress that fast-forwards the warm-up (``warmup_speed``) once the first reference
+    round has taken the cold readings, switches to ``run_speed`` for the holes, and passes
+    every event on."""
 
     def progress(event: str, data: dict) -> None:
+        if event == "round" and data["round"] == 0:
+            sim.world.clock.set_speed(opts.warmup_speed)
         if event == "state" and data["state"] == "inspecting":
             sim.world.clock.set_speed(opts.run_speed)
         if run_progress is not None:

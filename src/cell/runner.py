@@ -93,7 +93,8 @@ class RunResult:
     thermal: str = ""
 
 
-#: ``progress(event, data)`` for the CLI: events "state", "hole", "reference"
+#: ``progress(event, data)`` for the CLI: events "state", "round" (a reference round starts),
+#: "reference" (a reference view measured), "hole"
 Progress = Callable[[str, dict], None]
 
 
@@ -289,6 +290,7 @@ class Runner:
         """Reload the stored reference observations; use the given model (stored if new) or
         else the model the run used last."""
         self.thermal.rows = stored_rows(self.store)
+        self.thermal.cold_degC = self.store.thermal_reference()
         self._round0 = 1 + max((r[5] for r in self.thermal.rows), default=-1)
         if self.model is not None:
             self.model_id = remember_model(self.store, self.model, "given (--thermal)")
@@ -314,7 +316,12 @@ class Runner:
         tour = self.reference_tour
         self._load(tour)
         for rnd in range(self.options.reference_rounds):
-            t_start = self._call("status", self.client.status).time_s
+            st_start = self._call("status", self.client.status)
+            t_start = st_start.time_s
+            if self.thermal.cold_degC is None:  # the cold state: before the arm first moves
+                self.thermal.cold_degC = tuple(float(v) for v in st_start.temperatures_c)
+                self.store.set_thermal_reference(self.thermal.cold_degC)
+            self.progress("round", {"round": rnd, "time_s": t_start})
             for k, s in enumerate(tour.stops):
                 self._move(k, f"reference {s.hole_id}")
                 st = self._settled_status()

@@ -259,6 +259,19 @@ class Store:
             ) from exc
 
     # --- thermal ----------------------------------------------------------------------------
+    def set_thermal_reference(self, temps_degC: Any) -> None:
+        """Store the run's thermal reference readings (degC, one per sensor)."""
+        with self._con:
+            self._con.execute("INSERT OR REPLACE INTO meta VALUES ('thermal_reference_degC', ?)",
+                              (_floats(temps_degC),))  # fmt: skip
+
+    def thermal_reference(self) -> tuple[float, ...] | None:
+        """The run's thermal reference readings (degC), or None if none was taken yet."""
+        row = self._con.execute(
+            "SELECT value FROM meta WHERE key = 'thermal_reference_degC'"
+        ).fetchone()
+        return None if row is None else tuple(json.loads(row[0]))
+
     def record_reference(
         self, round_index: int, t_s: float, target: str, q: Any, temps: Any, p_tcp: Any
     ) -> None:

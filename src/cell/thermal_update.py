@@ -9,7 +9,8 @@ one reading as a sensor shared by every link; other counts are refused.
 
 The reference temperatures (where the nominal D-H table holds) follow the rule of
 ``holecell thermal identify`` (:func:`robots.thermal.identify.reference_from_cold`): the
-readings of the cold state, here those of the first reference round's earliest observation.
+readings of the cold state, here those the controller reports as the first reference round
+starts (before the arm moves), or else those of the round's earliest observation.
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ class ThermalUpdate:
     cell: CellConfig
     arm: Arm
     rows: list[Row] = field(default_factory=list)
+    cold_degC: tuple[float, ...] | None = None  # noqa: N815 (unit suffix)
     result: IdentificationResult | None = None
     refusal: str = ""
 
@@ -76,9 +78,12 @@ class ThermalUpdate:
         )
 
     def reference_degC(self) -> tuple[float, ...]:
-        """Per-sensor reading (degC) of the cold state: the earliest observation of the first
-        reference round (the mean of the rows at that time), as
+        """Per-sensor reading (degC) of the cold state: ``cold_degC`` (the readings as the first
+        reference round starts) when known, else the earliest observation of the first round
+        (the mean of the rows at that time), as
         :func:`robots.thermal.identify.reference_from_cold` takes it from a file."""
+        if self.cold_degC is not None:
+            return self.cold_degC
         first = min(r[5] for r in self.rows)
         t0 = min(r[0] for r in self.rows if r[5] == first)
         temps = np.array([r[3] for r in self.rows if r[5] == first and r[0] == t0])

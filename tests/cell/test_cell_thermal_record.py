@@ -53,6 +53,10 @@ def test_observations_and_model_are_stored_and_reloaded(
         with Store.open(tmp_path) as store:
             n_obs = len(store.reference_observations())
             model_id, source, text = store.latest_model()
+            cold = store.thermal_reference()
+        # the reference is the cold state: the readings as the first round started
+        assert cold is not None and len(cold) == 6
+        assert json.loads(text)["sensors"]["reference_degC"] == list(cold)
         assert n_obs >= 2 * len(small_cell.reference.stops) - 2
         assert "identified" in source and json.loads(text)["format"] == "holecell.thermal/1"
         # resumed without reference rounds: the stored model compensates the next hole
@@ -63,7 +67,8 @@ def test_observations_and_model_are_stored_and_reloaded(
     with Store.open(tmp_path) as store:
         obs = store.reference_observations()
         used = [r.thermal_model_id for r in store.results()]
-        last_id = store.latest_model()[0]
+        last_id, _, store_text = store.latest_model()
     assert sorted({r[5] for r in obs}) == [0, 1, 2]
+    assert json.loads(store_text)["sensors"]["reference_degC"] == list(cold)
     assert f"identified from {len(obs)} rows" in result.thermal
     assert used == [model_id, model_id, last_id] and last_id != model_id
