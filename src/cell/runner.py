@@ -64,7 +64,9 @@ class RunOptions:
         settle_s: wait after "in position" before the capture.
         move_timeout_s: longest wait for one move.
         reconnect_budget_s: how long a dead link is retried before the run stops.
-        reference_rounds: rounds over the reference targets before the holes (0: none).
+        reference_rounds: rounds over the reference targets before the holes (0: none). A
+            model is identified only from rounds at different temperatures, so at least two,
+            ``reference_interval_s`` apart.
         reference_interval_s: controller-clock seconds between the starts of two rounds.
 
     The reference temperatures of an identified model are the first reference round's readings
@@ -74,7 +76,7 @@ class RunOptions:
     settle_s: float = 0.2
     move_timeout_s: float = 120.0
     reconnect_budget_s: float = 15.0
-    reference_rounds: int = 1
+    reference_rounds: int = 2
     reference_interval_s: float = 300.0
 
 

@@ -40,6 +40,9 @@ def sensor_spec(n_sensors: int, reference_c: float | Sequence[float]) -> Thermal
     return ThermalSpec.mapped(names, tuple(float(v) for v in ref))
 
 
+#: smallest change of a reading (K) over the rows for a temperature model to be identifiable
+MIN_SPREAD_K = 0.2
+
 #: one observation: (time s, target id, joints rad, readings degC, target in TCP frame m, round)
 Row = tuple[float, str, np.ndarray, np.ndarray, np.ndarray, int]
 
@@ -103,10 +106,25 @@ class ThermalUpdate:
             source="run reference targets",
         )
 
+    def temperature_spread_K(self) -> float:
+        """Largest change of any sensor's reading over the rows so far (K)."""
+        temps = np.array([r[3] for r in self.rows])
+        return float(np.max(temps.max(axis=0) - temps.min(axis=0))) if len(temps) else 0.0
+
     def identify(self) -> ThermalModel | None:
         """Identify from every row so far; None (``refusal`` says why) if nothing identifiable."""
         if not self.rows:
             self.refusal = "no reference observations"
+            return None
+        spread = self.temperature_spread_K()
+        if spread < MIN_SPREAD_K:
+            rounds = len({r[5] for r in self.rows})
+            self.refusal = (
+                f"the reference targets were seen at a single temperature state ({rounds} "
+                f"round(s), readings within {spread:.2f} K); identification needs rounds at "
+                "different temperatures: more --reference-rounds, further apart "
+                "(--reference-interval-s), or give a model with --thermal"
+            )
             return None
         try:
             obs = self.observations()

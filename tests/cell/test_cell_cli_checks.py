@@ -64,3 +64,11 @@ def test_reference_views_left_out_are_info(small_cell: SmallCell, caplog) -> Non
     assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
     left = [r for r in caplog.records if "left out" in r.getMessage()]
     assert left and all(r.levelno == logging.INFO for r in left)
+
+
+def test_run_default_reference_rounds_can_identify() -> None:
+    from cell.cli import build_parser
+    from cell.runner import RunOptions
+
+    args = build_parser().parse_args(["run", "t.json", "--port", "p", "--camera", "c"])
+    assert args.reference_rounds == RunOptions().reference_rounds >= 2

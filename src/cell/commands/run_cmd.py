@@ -34,7 +34,10 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Reads TOUR (tour.json from holecell plan) and CELL (the cell file it was planned "
             "for; refused otherwise), connects to the controller at --port (/dev/ttyS0, "
             "socket://host:port or a pty path) and the stereo head at --camera, measures the "
-            "reference targets and updates the thermal compensation, then measures every hole. "
+            "reference targets in --reference-rounds rounds and identifies the thermal "
+            "compensation from them (when the readings changed between rounds; else it keeps "
+            "the --thermal model, checked against the cell, or the nominal kinematics), then "
+            "measures every hole. "
             "Writes RUN_DIR/results.sqlite (every hole in its own transaction), report.json "
             "and report.csv, and records the run to RUN_DIR/run.rrd (Rerun; --spawn or --connect "
             "to watch it live). --resume RUN_DIR continues a stopped run from the first hole not "
@@ -48,8 +51,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default=None, help="run directory to create (default: runs/<tour>)")
     p.add_argument("--resume", metavar="RUN_DIR", help="continue the run stored in RUN_DIR")
     p.add_argument("--thermal", help="thermal.json model to start from (holecell thermal)")
-    p.add_argument("--reference-rounds", type=non_negative_int, default=1,
-                   help="rounds over the targets")  # fmt: skip
+    p.add_argument("--reference-rounds", type=non_negative_int, default=2,
+                   help="rounds over the reference targets before the holes, "
+                        "--reference-interval-s apart (default 2: a model is identified only "
+                        "from rounds at different temperatures; 0: no thermal update, the "
+                        "--thermal model or the nominal kinematics)")  # fmt: skip
     p.add_argument("--reference-interval-s", type=non_negative_float, default=300.0,
                    help="controller seconds between reference rounds")  # fmt: skip
     p.add_argument("--settle-s", type=non_negative_float, default=0.2,
