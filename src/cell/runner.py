@@ -16,7 +16,6 @@ import sqlite3
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import TypeVar
 
 import numpy as np
 
@@ -24,11 +23,11 @@ from cell.camera import CameraBackend
 from cell.config import CellConfig
 from cell.errors import CellError
 from cell.inspect_hole import T_cell_tcp, inspect_hole
-from cell.link import messages as m
 from cell.link.client import ControllerClient
-from cell.link.errors import LinkError, MoveTimeoutError, RequestRefusedError
+from cell.link.errors import LinkError
 from cell.reference import target_of
 from cell.results import HoleResult
+from cell.run_motion import Motion, RunFaultError, stop_rows  # noqa: F401 (re-exported)
 from cell.store import Store
 from cell.thermal_record import remember_model, stored_model, stored_rows
 from cell.thermal_update import ThermalUpdate
@@ -38,22 +37,10 @@ from robots.thermal.model import ThermalModel
 from robots.transforms import invert
 
 log = logging.getLogger(__name__)
-T = TypeVar("T")
 
 #: the arm is at a joint vector if every joint is within this (rad; half the controller's
 #: on-path tolerance of 1e-3 degrees)
 HOME_TOL_RAD = float(np.deg2rad(0.5e-3))
-
-
-class RunFaultError(CellError):
-    """The run stopped on a controller fault; ``state`` and ``fault`` as the controller said."""
-
-    def __init__(self, where: str, state: str, fault: str) -> None:
-        self.where, self.state, self.fault = where, state, fault
-        super().__init__(
-            f"run stopped at {where}: controller {state} ({fault}); every hole measured so far "
-            "is stored; clear the fault, then continue with --resume RUN_DIR"
-        )
 
 
 @dataclass(frozen=True)
@@ -100,18 +87,7 @@ class RunResult:
 Progress = Callable[[str, dict], None]
 
 
-def stop_rows(tour: Tour) -> list[int]:
-    """Trajectory row of every stop (arrival time / dt), checked against the stop's joints."""
-    rows = []
-    for k, s in enumerate(tour.stops):
-        r = round(s.t / tour.dt)
-        if not 0 <= r < len(tour.trajectory) or not np.allclose(tour.trajectory[r], s.q, atol=1e-6):
-            raise CellError(f"tour: stop {k} ({s.hole_id}) is not on the trajectory at t={s.t}")
-        rows.append(r)
-    return rows
-
-
-class Runner:
+class Runner(Motion):
     """Runs one tour of one cell on one controller, storing into one run store."""
 
     def __init__(
@@ -214,78 +190,6 @@ class Runner:
         self.progress("state", {"state": state, **extra})
         if self.recorder is not None:
             self.recorder.state(state)
-
-    # --- motion ----------------------------------------------------------------------------
-    def _load(self, tour: Tour) -> None:
-        self._loaded, self._need_load = tour, True
-        self._call("load trajectory", self._ensure_loaded)
-
-    def _ensure_loaded(self) -> None:
-        if self._need_load and self._loaded is not None:
-            self.client.load_trajectory(self._loaded.trajectory, stop_rows(self._loaded),
-                                        self._loaded.dt)  # fmt: skip
-            self._need_load = False
-
-    def _call(self, where: str, fn: Callable[[], T]) -> T:
-        """``fn()`` on the link, reconnecting (and reloading) while the link is dead."""
-        while True:
-            try:
-                self._ensure_loaded()
-                return fn()
-            except LinkError as exc:
-                self._recover(exc, where)
-
-    def _move(self, k: int, where: str) -> m.Status:
-        """Bring the arm to stop ``k`` of the loaded tour, surviving a dead link."""
-        deadline = time.monotonic() + self.options.move_timeout_s
-
-        def go() -> m.Status:
-            self.client.move_to_stop(k)
-            return self.client.wait_in_position(k, self.options.move_timeout_s)
-
-        while True:
-            try:
-                st = self._call(where, go)
-            except MoveTimeoutError as exc:
-                self._safe_stop()
-                raise RunFaultError(where, exc.state, "move timed out") from exc
-            except RequestRefusedError as exc:
-                if exc.code == m.Nak.NOT_LOADED:  # the controller lost the trajectory
-                    self.store.event("motion", f"{where}: {exc}; reloading")
-                    self._need_load = True
-                    continue
-                st = self._call(where, self.client.status)
-                if st.state in (m.State.ESTOP, m.State.FAULT):
-                    raise RunFaultError(where, st.state.name, st.fault.name) from exc
-                raise
-            if st.state == m.State.IN_POSITION and st.at_stop == k:
-                return st
-            if st.state in (m.State.ESTOP, m.State.FAULT):
-                raise RunFaultError(where, st.state.name, st.fault.name)
-            self.store.event("motion", f"{where}: {st.state.name} ({st.fault.name}), moving on")
-            if time.monotonic() > deadline:
-                raise RunFaultError(where, st.state.name, "move timed out")
-
-    def _recover(self, exc: LinkError, where: str) -> None:
-        """Reconnect within the budget (LinkError beyond it); the trajectory is reloaded."""
-        self.store.event("link", f"{where}: {exc}; reconnecting")
-        self.client.reconnect(self.options.reconnect_budget_s)
-        self._need_load = True
-        self.store.event("link", f"{where}: link restored")
-
-    def _safe_stop(self) -> None:
-        """Ask the controller to stop the arm; a failure is recorded, never raised."""
-        try:
-            self.client.stop()
-        except (CellError, OSError, KeyboardInterrupt) as exc:
-            try:
-                self.store.event("fault", f"stop request failed: {exc}")
-            except (CellError, sqlite3.Error) as err:
-                log.error("stop request failed (%s) and could not be recorded: %s", exc, err)
-
-    def _settled_status(self) -> m.Status:
-        time.sleep(self.options.settle_s)
-        return self._call("status", self.client.status)
 
     # --- thermal state in the store --------------------------------------------------------
     def _restore_thermal(self) -> None:
