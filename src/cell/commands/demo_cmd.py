@@ -59,7 +59,8 @@ def format_demo(res: DemoResult) -> str:
     worst = s["worst_position_deviation_m"]
     rows = [
         ("holes measured", f"{bar(measured, planned, 20)} {measured}/{planned}"),
-        ("missing / out of tol.", f"{s['holes_missing']} / {s['holes_failed']}"),
+        ("missing / unmeasurable", f"{s['holes_missing']} / {s['holes_unmeasured']}"),
+        ("out of tol. / suspect", f"{s['holes_failed']} / {s['holes_suspect']}"),
         ("worst deviation", f"{worst * 1e3:.4f} mm (hole {s['worst_hole']})" if worst else "-"),
         ("cycle time (planned)", f"{res.tour.cycle_time_s:.1f} s"),
         ("error vs truth, RMS", f"{tr.rms_m * 1e6:.1f} um (max {tr.max_m * 1e6:.1f} um)"),
