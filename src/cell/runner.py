@@ -197,6 +197,10 @@ class Runner(Motion):
         else the model the run used last."""
         self.thermal.rows = stored_rows(self.store)
         self.thermal.cold_degC = self.store.thermal_reference()
+        if self.thermal.cold_degC is None and self.model is not None:
+            # a given model knows the cold state of this arm: identify relative to it
+            self.thermal.cold_degC = tuple(self.model.spec.reference_degC)
+            self.store.set_thermal_reference(self.thermal.cold_degC)
         self._round0 = 1 + max((r[5] for r in self.thermal.rows), default=-1)
         if self.model is not None:
             self.model_id = remember_model(self.store, self.model, "given (--thermal)")

@@ -72,3 +72,31 @@ def test_observations_and_model_are_stored_and_reloaded(
     assert json.loads(store_text)["sensors"]["reference_degC"] == list(cold)
     assert f"identified from {len(obs)} rows" in result.thermal
     assert used == [model_id, model_id, last_id] and last_id != model_id
+
+
+def test_given_model_sets_the_cold_state_of_a_warm_arm(small_cell: SmallCell, tmp_path: Path):
+    """A run that starts on an arm already warm (an hour into its warm-up) with a --thermal model
+    identifies relative to that model's reference temperatures (the cold state it knows), not
+    the warm readings of its first round, and so still compensates the whole warm-up."""
+    from cell.demo import truth_error
+    from cell.thermal_update import sensor_spec
+    from robots.thermal.model import ThermalModel
+
+    arm = small_cell.cell.build_arm()
+    given = ThermalModel(arm.dh, sensor_spec(6, 20.0), {}, robot_model=small_cell.cell.robot.model,
+                         T_cell_base=arm.T_cell_base, T_tool0_tcp=arm.T_tool0_tcp)  # fmt: skip
+    world = WorldOptions(speed=1500.0, drift_offset_s=3600.0)
+    with SimCell.start(small_cell.cell, world) as sim:
+        files = start_run(tmp_path, small_cell.cell, small_cell.tour, "t", sim.url,
+                          small_cell.reference)  # fmt: skip
+        options = RunOptions(settle_s=0.0, reference_rounds=3, reference_interval_s=600.0)
+        try:
+            with ControllerClient(sim.url, FAST_LINK) as client:
+                result = Runner(files.cell, files.tour, files.store, client, sim.camera, options,
+                                files.reference, given).run()  # fmt: skip
+            err = truth_error(sim.world, files.store.results())
+            assert files.store.thermal_reference() == (20.0,) * 6
+        finally:
+            files.store.close()
+    assert "identified" in result.thermal
+    assert err.rms_m < 0.2 * err.rms_uncompensated_m
