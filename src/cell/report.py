@@ -3,7 +3,9 @@
 Files are in SI units (m); the printed summary is for people (mm, um). CSV columns:
 ``hole_id, stop, status, nominal_x_m .. nominal_z_m, measured_x_m .. measured_z_m,
 position_deviation_m, nominal_diameter_m, diameter_m, diameter_deviation_m, tolerance_m,
-pass, u_center_m, u_diameter_m, reason`` (empty cells where a hole was not measured).
+pass, u_center_m, u_diameter_m, reason, thermal_model_id`` (empty cells where a hole was not
+measured; ``thermal_model_id``: the row of the store's ``thermal_models`` the hole was
+compensated with, empty for the nominal kinematics).
 ``u_*`` are one-sigma uncertainties from the circle fit's covariance.
 """
 
@@ -22,7 +24,7 @@ CSV_COLUMNS = (
     "nominal_x_m", "nominal_y_m", "nominal_z_m",
     "measured_x_m", "measured_y_m", "measured_z_m",
     "position_deviation_m", "nominal_diameter_m", "diameter_m", "diameter_deviation_m",
-    "tolerance_m", "pass", "u_center_m", "u_diameter_m", "reason",
+    "tolerance_m", "pass", "u_center_m", "u_diameter_m", "reason", "thermal_model_id",
 )  # fmt: skip
 
 
@@ -74,6 +76,7 @@ def _row(r: HoleResult) -> dict[str, Any]:
         "u_center_m": r.u_center_m,
         "u_diameter_m": r.u_diameter_m,
         "reason": r.reason,
+        "thermal_model_id": r.thermal_model_id,
     }  # fmt: skip
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 from cell_fixtures import SmallCell
 
 from cell.link.client import ControllerClient, LinkOptions
+from cell.report import write_report
 from cell.run_setup import resume_run, start_run
 from cell.runner import Runner, RunOptions
 from cell.sim.session import SimCell
@@ -72,12 +73,15 @@ def test_observations_and_model_are_stored_and_reloaded(
     assert json.loads(store_text)["sensors"]["reference_degC"] == list(cold)
     assert f"identified from {len(obs)} rows" in result.thermal
     assert used == [model_id, model_id, last_id] and last_id != model_id
+    rows = write_report(tmp_path) and json.loads((tmp_path / "report.json").read_text())["holes"]
+    assert [row["thermal_model_id"] for row in rows] == used
 
 
 def test_given_model_sets_the_cold_state_of_a_warm_arm(small_cell: SmallCell, tmp_path: Path):
-    """A run that starts on an arm already warm (an hour into its warm-up) with a --thermal model
-    identifies relative to that model's reference temperatures (the cold state it knows), not
-    the warm readings of its first round, and so still compensates the whole warm-up."""
+    """A run that starts on an arm already warm (half an hour into its warm-up) with a --thermal
+    model identifies relative to that model's reference temperatures (the cold state it knows),
+    not the warm readings of its first round, and so still compensates the whole warm-up (taking
+    the warm readings as reference leaves most of the drift: a ratio near 1)."""
     from cell.demo import truth_error
     from cell.thermal_update import sensor_spec
     from robots.thermal.model import ThermalModel
@@ -85,7 +89,7 @@ def test_given_model_sets_the_cold_state_of_a_warm_arm(small_cell: SmallCell, tm
     arm = small_cell.cell.build_arm()
     given = ThermalModel(arm.dh, sensor_spec(6, 20.0), {}, robot_model=small_cell.cell.robot.model,
                          T_cell_base=arm.T_cell_base, T_tool0_tcp=arm.T_tool0_tcp)  # fmt: skip
-    world = WorldOptions(speed=1500.0, drift_offset_s=3600.0)
+    world = WorldOptions(speed=1500.0, drift_offset_s=1800.0)
     with SimCell.start(small_cell.cell, world) as sim:
         files = start_run(tmp_path, small_cell.cell, small_cell.tour, "t", sim.url,
                           small_cell.reference)  # fmt: skip
@@ -99,4 +103,4 @@ def test_given_model_sets_the_cold_state_of_a_warm_arm(small_cell: SmallCell, tm
         finally:
             files.store.close()
     assert "identified" in result.thermal
-    assert err.rms_m < 0.2 * err.rms_uncompensated_m
+    assert err.rms_m < 0.4 * err.rms_uncompensated_m
