@@ -62,9 +62,7 @@ def T_part_camera(
     TCP frame (identity when the measurement is expressed in the TCP frame).
     """
     T_tcp_cam = np.eye(4) if T_tcp_cam is None else np.asarray(T_tcp_cam, float)
-    T_cell_tcp = compensated_T_cell_tcp(
-        model, model.T_cell_base, model.T_tool0_tcp, q, temps_degC
-    )
+    T_cell_tcp = compensated_T_cell_tcp(model, model.T_cell_base, model.T_tool0_tcp, q, temps_degC)
     return invert(T_cell_part) @ T_cell_tcp @ T_tcp_cam
 
 
