@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from cell_fixtures import SmallCell
 
 from cell.cli import main
@@ -52,10 +53,8 @@ def test_resume_after_estop_at_a_hole_with_default_reference_rounds(
         runner, files, client = _runner(small_cell, tmp_path, sim, False,
                                         _estop_while_inspecting(sim))  # fmt: skip
         try:
-            runner.run()
-            raise AssertionError("the e-stop did not stop the run")
-        except RunFaultError:
-            pass
+            with pytest.raises(RunFaultError):
+                runner.run()
         finally:
             client.close()
             files.store.close()
