@@ -34,7 +34,7 @@ from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store
+from cell.store import Store, count_measurements
 from planner import Options, plan_tour
 from robots.thermal.drift import DriftSettings, WarmUp
 
@@ -130,12 +130,12 @@ def kill_resume(cell, tour, root: Path, seeds: list[int]) -> None:
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                      env=env)  # fmt: skip
             target = rng.randrange(len(tour.stops))
-            while _count(run_dir) < target and first.poll() is None:
+            while count_measurements(run_dir) < target and first.poll() is None:
                 time.sleep(0.01)
             time.sleep(rng.uniform(0.0, 0.4))
             first.send_signal(signal.SIGKILL)
             first.wait()
-            before = _count(run_dir)
+            before = count_measurements(run_dir)
             second = subprocess.run([*cmd, "--resume", str(run_dir), "--yes", *common],
                                     capture_output=True, env=env)  # fmt: skip
         with Store.open(run_dir) as store:
@@ -150,22 +150,6 @@ def kill_resume(cell, tour, root: Path, seeds: list[int]) -> None:
     table("Killed at a random point (SIGKILL), then holecell run --resume",
           ["seed", "stored at kill", "stored at end", "resume exit", "equals uninterrupted"],
           rows)  # fmt: skip
-
-
-def _count(run_dir: Path) -> int:
-    import sqlite3
-
-    path = run_dir / "results.sqlite"
-    if not path.exists():
-        return -1
-    try:
-        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-        try:
-            return con.execute("SELECT count(*) FROM measurements").fetchone()[0]
-        finally:
-            con.close()
-    except sqlite3.DatabaseError:
-        return -1
 
 
 def overhead(cell, tour, root: Path) -> None:

@@ -329,6 +329,24 @@ class Store:
         return out
 
 
+def count_measurements(run_dir: Path) -> int:
+    """Measurements stored in a run directory, read-only; -1 when there is no readable store.
+
+    Safe to call while another process writes the store (used to watch a run from outside).
+    """
+    path = Path(run_dir) / "results.sqlite"
+    if not path.exists():
+        return -1
+    try:
+        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            return int(con.execute("SELECT count(*) FROM measurements").fetchone()[0])
+        finally:
+            con.close()
+    except sqlite3.DatabaseError:
+        return -1
+
+
 def _floats(values: Any) -> str:
     return json.dumps([float(v) for v in values])
 

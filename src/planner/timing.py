@@ -1,8 +1,8 @@
 """Jerk-limited time parameterisation with ruckig.
 
 Only single-target ruckig calculations are used, chained one after the other
-(``intermediate_positions`` is never set: the free ruckig package would send it
-to a remote service). A straight joint-space segment is timed rest-to-rest
+(ruckig's intermediate-waypoint input is never set: the free package would send
+the waypoints to a remote service). A straight joint-space segment is timed rest-to-rest
 with phase synchronisation, which keeps it on the straight line. A multi-point
 path (from OMPL) is timed through its waypoints with non-zero velocity where
 the caller's collision check of the sampled motion allows, else with a stop.

@@ -6,7 +6,6 @@ from __future__ import annotations
 import os
 import random
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
@@ -22,7 +21,7 @@ from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store
+from cell.store import Store, count_measurements
 
 
 def _inprocess_run(sc: SmallCell, run_dir: Path, sim: SimCell, link: LinkOptions):
@@ -54,20 +53,6 @@ def test_dropped_corrupted_frames_and_a_disconnect(small_cell: SmallCell, tmp_pa
     assert any(e["kind"] == "link" and "restored" in e["message"] for e in events)
 
 
-def _n_stored(run_dir: Path) -> int:
-    path = run_dir / "results.sqlite"
-    if not path.exists():
-        return -1
-    try:
-        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-        try:
-            return con.execute("SELECT count(*) FROM measurements").fetchone()[0]
-        finally:
-            con.close()
-    except sqlite3.DatabaseError:
-        return -1
-
-
 def _holecell(*args: str) -> subprocess.Popen:
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     cmd = [sys.executable, "-m", "cell.cli", *args]
@@ -97,7 +82,7 @@ def test_killed_runner_resumes_to_the_same_store(small_cell: SmallCell, tmp_path
         )
         # a random point inside the run: after k holes are stored, part way into the next
         k = rng.randrange(len(reference))
-        while _n_stored(run_dir) < k and first.poll() is None:
+        while count_measurements(run_dir) < k and first.poll() is None:
             time.sleep(0.005)
         time.sleep(rng.uniform(0.0, 0.5 * clean.timings["run_s"] / len(reference)))
         first.send_signal(signal.SIGKILL)
