@@ -23,18 +23,18 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.camera import StereoPair
 from cell.config import builtin_cell_path, load_builtin_cell
 from cell.link.client import ControllerClient, LinkOptions
 from cell.link.messages import rad_to_wire
-from cell.record import Recorder
-from cell.run_setup import start_run
-from cell.runner import Runner, RunOptions, stop_rows
+from cell.review.recording import Recorder
+from cell.review.store import Store, count_measurements
+from cell.run.camera import StereoPair
+from cell.run.runner import Runner, RunOptions, stop_rows
+from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store, count_measurements
 from planner import Options, plan_tour
 from robots.thermal.drift import DriftSettings, WarmUp
 

@@ -10,7 +10,7 @@ import pytest
 from cell_fixtures import SmallCell
 
 from cell.cli import main
-from cell.reference import plan_reference_tour
+from cell.run.reference import plan_reference_tour
 from planner import Options
 
 
@@ -68,7 +68,7 @@ def test_reference_views_left_out_are_info(small_cell: SmallCell, caplog) -> Non
 
 def test_run_default_reference_rounds_can_identify() -> None:
     from cell.cli import build_parser
-    from cell.runner import RunOptions
+    from cell.run.runner import RunOptions
 
     args = build_parser().parse_args(["run", "t.json", "--port", "p", "--camera", "c"])
     assert args.reference_rounds == RunOptions().reference_rounds >= 2

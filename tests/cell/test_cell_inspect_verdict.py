@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from cell_fixtures import SmallCell
 
-import cell.inspect_hole as ih
-from cell.camera import cell_stereo
-from cell.report import summary, write_report
-from cell.results import HoleResult
-from cell.run_setup import start_run
+import cell.run.inspect as ih
+from cell.review.report import summary, write_report
+from cell.run.camera import cell_stereo
+from cell.run.results import HoleResult
+from cell.run.setup import start_run
 from measure import head_frame
 from robots.transforms import invert
 

@@ -10,14 +10,14 @@ from pathlib import Path
 import pytest
 from cell_fixtures import SmallCell
 
+import cell.review.store as store_mod
 import cell.sim.session as session
-import cell.store as store_mod
 from cell.errors import CellError
-from cell.run_setup import resume_run, start_run
+from cell.review.store import Store, StoreError
+from cell.run.setup import resume_run, start_run
 from cell.sim.controller import SimController
 from cell.sim.server import SimServer
 from cell.sim.world import SimWorld
-from cell.store import Store, StoreError
 
 
 @pytest.fixture

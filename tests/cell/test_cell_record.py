@@ -9,9 +9,9 @@ import rerun.chunk as rrc
 from cell_fixtures import SmallCell, steady_drift
 
 from cell.link.client import ControllerClient
-from cell.record import Recorder
-from cell.run_setup import start_run
-from cell.runner import Runner, RunOptions
+from cell.review.recording import Recorder
+from cell.run.runner import Runner, RunOptions
+from cell.run.setup import start_run
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
 

@@ -15,13 +15,13 @@ import numpy as np
 from cell_fixtures import SmallCell, steady_drift
 
 from cell.link.client import ControllerClient, LinkOptions
-from cell.run_setup import start_run
-from cell.runner import Runner, RunOptions
+from cell.review.store import Store, count_measurements
+from cell.run.runner import Runner, RunOptions
+from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store, count_measurements
 
 
 def _inprocess_run(sc: SmallCell, run_dir: Path, sim: SimCell, link: LinkOptions):

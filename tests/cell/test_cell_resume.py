@@ -11,13 +11,13 @@ from cell_fixtures import SmallCell
 
 from cell.cli import main
 from cell.link.client import ControllerClient, LinkOptions
-from cell.run_setup import resume_run, start_run
-from cell.runner import RunFaultError, Runner, RunOptions
+from cell.review.store import Store
+from cell.run.runner import RunFaultError, Runner, RunOptions
+from cell.run.setup import resume_run, start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store
 
 FAST_LINK = LinkOptions(response_timeout_s=0.05, retries=20, heartbeat_period_s=0.1)
 #: a fast clock: the default 300 s between reference rounds pass in 0.2 s

@@ -10,16 +10,16 @@ from pathlib import Path
 import pytest
 from cell_fixtures import SmallCell, steady_drift
 
-from cell.camera import CameraError
 from cell.cli import main
 from cell.link import messages as m
 from cell.link.client import ControllerClient, LinkOptions
-from cell.run_setup import start_run
-from cell.runner import RunFaultError, Runner, RunOptions
+from cell.review.store import Store
+from cell.run.camera import CameraError
+from cell.run.runner import RunFaultError, Runner, RunOptions
+from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store
 
 FAST_LINK = LinkOptions(response_timeout_s=0.05, retries=20, heartbeat_period_s=0.1)
 WORLD = WorldOptions(speed=50.0, drift=steady_drift())

@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 from cell_fixtures import SmallCell, steady_drift
 
-from cell.demo import truth_error
 from cell.link.client import ControllerClient, LinkOptions
-from cell.run_setup import TourMismatchError, resume_run, start_run
-from cell.runner import RunFaultError, Runner, RunOptions
+from cell.review.store import Store
+from cell.run.demo import truth_error
+from cell.run.runner import RunFaultError, Runner, RunOptions
+from cell.run.setup import TourMismatchError, resume_run, start_run
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store
 
 FAST_LINK = LinkOptions(response_timeout_s=0.05, retries=20, heartbeat_period_s=0.1)
 
@@ -133,7 +133,7 @@ def test_cli_refuses_truncated_tour_and_corrupt_store(
 
 
 def test_stored_result_matches_report(small_cell: SmallCell, tmp_path: Path) -> None:
-    from cell.report import write_report
+    from cell.review.report import write_report
 
     with SimCell.start(small_cell.cell, WorldOptions(speed=20.0, drift=steady_drift())) as sim:
         _, stored, _ = _run(small_cell, tmp_path, sim)

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from cell.report import write_report
-from cell.results import HoleResult
-from cell.store import Store, StoreError
+from cell.review.report import write_report
+from cell.review.store import Store, StoreError
+from cell.run.results import HoleResult
 
 
 def _store(tmp_path: Path) -> Store:

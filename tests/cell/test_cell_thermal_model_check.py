@@ -11,11 +11,11 @@ import pytest
 from cell_fixtures import SmallCell, steady_drift
 
 from cell.cli import main
-from cell.inspect_hole import T_cell_tcp
+from cell.run.inspect import T_cell_tcp
+from cell.run.thermal_update import sensor_spec
 from cell.sim.camserver import CameraServer
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.thermal_update import sensor_spec
 from robots.thermal.compensate import compensated_T_cell_tcp
 from robots.thermal.model import ThermalModel
 from robots.thermal.modelfile import save_model

@@ -9,12 +9,12 @@ from pathlib import Path
 from cell_fixtures import SmallCell
 
 from cell.link.client import ControllerClient, LinkOptions
-from cell.report import write_report
-from cell.run_setup import resume_run, start_run
-from cell.runner import Runner, RunOptions
+from cell.review.report import write_report
+from cell.review.store import Store
+from cell.run.runner import Runner, RunOptions
+from cell.run.setup import resume_run, start_run
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
-from cell.store import Store
 
 FAST_LINK = LinkOptions(response_timeout_s=0.05, retries=20, heartbeat_period_s=0.1)
 
@@ -82,8 +82,8 @@ def test_given_model_sets_the_cold_state_of_a_warm_arm(small_cell: SmallCell, tm
     model identifies relative to that model's reference temperatures (the cold state it knows),
     not the warm readings of its first round, and so still compensates the whole warm-up (taking
     the warm readings as reference leaves most of the drift: a ratio near 1)."""
-    from cell.demo import truth_error
-    from cell.thermal_update import sensor_spec
+    from cell.run.demo import truth_error
+    from cell.run.thermal_update import sensor_spec
     from robots.thermal.model import ThermalModel
 
     arm = small_cell.cell.build_arm()

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from cell_fixtures import SmallCell
 
-from cell.thermal_update import ThermalUpdate, sensor_spec
+from cell.run.thermal_update import ThermalUpdate, sensor_spec
 from robots.thermal.compensate import compensated_T_cell_tcp
 from robots.thermal.model import ThermalModel
 from robots.transforms import invert

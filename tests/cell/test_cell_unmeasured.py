@@ -7,11 +7,11 @@ from pathlib import Path
 
 from cell_fixtures import SmallCell, steady_drift
 
-import cell.inspect_hole as ih
+import cell.run.inspect as ih
 from cell.link.client import ControllerClient, LinkOptions
-from cell.report import summary
-from cell.run_setup import resume_run, start_run
-from cell.runner import Runner, RunOptions
+from cell.review.report import summary
+from cell.run.runner import Runner, RunOptions
+from cell.run.setup import resume_run, start_run
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
 from measure.errors import FitError

@@ -10,7 +10,7 @@ from robots.urdf_writer import URDF_DIR, urdf_text
 
 NAMES = sorted(MODELS)
 
-# flange position at q = 0 from shared/reference/abb_kinematics.md (m)
+# flange position at q = 0 from docs/abb_kinematics.md (m)
 FLANGE_AT_ZERO = {
     "abb_irb1600_10_145": (0.815, 0.0, 1.1865),
     "abb_irb2600_20_165": (1.030, 0.0, 1.260),

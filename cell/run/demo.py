@@ -23,11 +23,11 @@ import numpy as np
 
 from cell.config import CellConfig, load_builtin_cell
 from cell.link.client import ControllerClient
-from cell.reference import plan_reference_tour
-from cell.report import write_report
-from cell.results import HoleResult
-from cell.run_setup import RunFiles, check_new_run_dir, start_run
-from cell.runner import Progress, Runner, RunOptions, RunResult
+from cell.review.report import write_report
+from cell.run.reference import plan_reference_tour
+from cell.run.results import HoleResult
+from cell.run.runner import Progress, Runner, RunOptions, RunResult
+from cell.run.setup import RunFiles, check_new_run_dir, start_run
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import SimWorld, WorldOptions

@@ -7,19 +7,19 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from cell.camera import NetworkCamera, cell_stereo
 from cell.commands.argtypes import non_negative_float, non_negative_int
 from cell.commands.run_progress import RunBars
 from cell.config import CellConfig, load_cell
 from cell.errors import CellError
 from cell.link import messages as m
 from cell.link.client import ControllerClient
-from cell.record import Recorder
-from cell.reference import plan_reference_tour
-from cell.report import format_summary, write_report
-from cell.run_setup import RunFiles, check_new_run_dir, check_tour, resume_run, start_run
-from cell.runner import Runner, RunOptions
-from cell.thermal_check import check_model_for_cell, check_model_sensors
+from cell.review.recording import Recorder
+from cell.review.report import format_summary, write_report
+from cell.run.camera import NetworkCamera, cell_stereo
+from cell.run.reference import plan_reference_tour
+from cell.run.runner import Runner, RunOptions
+from cell.run.setup import RunFiles, check_new_run_dir, check_tour, resume_run, start_run
+from cell.run.thermal_check import check_model_for_cell, check_model_sensors
 from planner import load_tour
 from robots.thermal.model import ThermalModel
 from robots.thermal.modelfile import load_model

@@ -16,8 +16,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from cell.results import HoleResult
-from cell.store import Store
+from cell.review.store import Store
+from cell.run.results import HoleResult
 
 CSV_COLUMNS = (
     "hole_id", "stop", "status",

@@ -16,7 +16,7 @@ from cell.errors import CellError
 from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError, MoveTimeoutError, RequestRefusedError
-from cell.store import Store
+from cell.review.store import Store
 from planner import Tour
 
 log = logging.getLogger(__name__)
@@ -46,7 +46,7 @@ def stop_rows(tour: Tour) -> list[int]:
 
 
 class Motion:
-    """The motion steps of :class:`cell.runner.Runner` (its base): uses ``client``, ``store``
+    """The motion steps of :class:`cell.run.runner.Runner` (its base): uses ``client``, ``store``
     and ``options`` (``move_timeout_s``, ``reconnect_budget_s``, ``settle_s``)."""
 
     client: ControllerClient

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from cell.errors import CellError
-from cell.results import HoleResult
+from cell.run.results import HoleResult
 
 SCHEMA_VERSION = 2
 #: versions :meth:`Store.open` can read; older ones get the tables added since (nothing removed)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from cell.report import format_summary, write_report
+from cell.review.report import format_summary, write_report
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 from typing import TextIO
 
-from cell.results import HoleResult
+from cell.run.results import HoleResult
 
 WIDTH = 30
 
@@ -18,7 +18,7 @@ def bar(done: int, total: int, width: int = WIDTH) -> str:
 
 
 class RunBars:
-    """The ``progress(event, data)`` callback of :class:`cell.runner.Runner` for a terminal."""
+    """The ``progress(event, data)`` callback of :class:`cell.run.runner.Runner` for a terminal."""
 
     def __init__(self, total_holes: int, already: int = 0, stream: TextIO = sys.stderr) -> None:
         self.total = total_holes

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import json
 
-from cell.store import Store
-from cell.thermal_update import Row
+from cell.review.store import Store
+from cell.run.thermal_update import Row
 from robots.thermal.model import ThermalModel
 from robots.thermal.modelfile import model_from_dict, model_to_dict
 
@@ -37,6 +37,6 @@ def stored_model(store: Store) -> tuple[int, ThermalModel] | None:
 
 
 def stored_rows(store: Store) -> list[Row]:
-    """The reference observations stored so far, as :class:`cell.thermal_update.ThermalUpdate`
+    """The reference observations stored so far, as :class:`cell.run.thermal_update.ThermalUpdate`
     rows."""
     return list(store.reference_observations())

@@ -28,7 +28,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from cell.config import CellConfig
-from cell.results import HoleResult
+from cell.run.results import HoleResult
 from planner import Tour
 from robots import Shape
 

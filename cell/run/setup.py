@@ -16,8 +16,8 @@ import numpy as np
 
 from cell.config import CellConfig, parse_cell
 from cell.errors import CellError
-from cell.runner import stop_rows
-from cell.store import FILENAME, Store
+from cell.review.store import FILENAME, Store
+from cell.run.runner import stop_rows
 from planner import Tour, TourCellMismatchError, check_tour_for_cell
 from planner.planner import cell_sha256
 from planner.tour import tour_from_dict

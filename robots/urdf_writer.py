@@ -134,7 +134,7 @@ def urdf_text(spec: ArmSpec) -> str:
     shapes = link_shapes(spec)
     lines = [
         '<?xml version="1.0"?>',
-        f"<!-- {spec.title}: written by robots/urdf_writer.py from shared/reference figures. -->",
+        f"<!-- {spec.title}: written by robots/urdf_writer.py from docs/abb_kinematics.md. -->",
         f'<robot name="{spec.name}">',
     ]
     for link in LINK_NAMES:

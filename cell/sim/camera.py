@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cell.camera import StereoPair
+from cell.run.camera import StereoPair
 from cell.sim.controller import SimController
 from cell.sim.world import SimWorld, TrueHole
 from measure import StereoCalibration, head_frame
@@ -36,7 +36,7 @@ class CaptureTruth:
 
 
 class SimCamera:
-    """A :class:`cell.camera.CameraBackend` rendering from a :class:`SimWorld`."""
+    """A :class:`cell.run.camera.CameraBackend` rendering from a :class:`SimWorld`."""
 
     def __init__(
         self,

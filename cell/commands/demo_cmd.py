@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from cell.commands.run_progress import RunBars, bar
-from cell.demo import DemoOptions, DemoResult, run_demo
+from cell.run.demo import DemoOptions, DemoResult, run_demo
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -44,7 +44,7 @@ def _plan_bars(quiet: bool):
 def _recorder_factory(args: argparse.Namespace):
     if args.no_record:
         return None
-    from cell.record import Recorder
+    from cell.review.recording import Recorder
 
     def factory(run_dir: Path, cell, tour):
         return Recorder.create(run_dir / "run.rrd", cell, tour, args.spawn, args.connect)

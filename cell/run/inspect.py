@@ -1,4 +1,4 @@
-"""One capture into one :class:`cell.results.HoleResult`: measure, carry into the part frame
+"""One capture into one :class:`cell.run.results.HoleResult`: measure, carry into the part frame
 through the (compensated) kinematics, compare with the nominal.
 
 Frames: the measurement comes in the LEFT camera optical frame; ``T_head_left`` (the inverse of
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from cell.config import CellConfig, HoleInCell
-from cell.results import HoleResult, deviations
+from cell.run.results import HoleResult, deviations
 from measure import HoleMeasurement, MeasurementError, StereoCalibration, head_frame, measure_hole
 from measure.errors import HoleNotFoundError
 from robots import Arm

@@ -1,6 +1,6 @@
 """The built-in ABB arm models: joint origins, limits and D-H parameters.
 
-Figures come from ``shared/reference/abb_kinematics.md`` (ABB product
+Figures come from ``docs/abb_kinematics.md`` (ABB product
 specifications). Every chain has six revolute joints with axes z, y, y, x, y, x
 in their own joint frames, all joint origins with rpy 0, ``link_6 -> flange``
 identity and ``link_6 -> tool0`` rotated +90 deg about y.

@@ -19,18 +19,18 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from cell.camera import CameraBackend
 from cell.config import CellConfig
 from cell.errors import CellError
-from cell.inspect_hole import T_cell_tcp, inspect_hole
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError
-from cell.reference import target_of
-from cell.results import HoleResult
-from cell.run_motion import Motion, RunFaultError, stop_rows  # noqa: F401 (re-exported)
-from cell.store import Store
-from cell.thermal_record import remember_model, stored_model, stored_rows
-from cell.thermal_update import ThermalUpdate
+from cell.review.store import Store
+from cell.run.camera import CameraBackend
+from cell.run.inspect import T_cell_tcp, inspect_hole
+from cell.run.motion import Motion, RunFaultError, stop_rows  # noqa: F401 (re-exported)
+from cell.run.reference import target_of
+from cell.run.results import HoleResult
+from cell.run.thermal_record import remember_model, stored_model, stored_rows
+from cell.run.thermal_update import ThermalUpdate
 from measure import MeasurementError, head_frame, measure_hole
 from planner import Tour
 from robots.thermal.model import ThermalModel
