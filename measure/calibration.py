@@ -5,7 +5,8 @@
     {"image_size": [w, h],
      "left":  {"K": [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], "dist": [k1, k2, p1, p2, k3]},
      "right": {"K": ..., "dist": ...},
-     "R": [[...], [...], [...]], "T": [tx, ty, tz]}
+     "R": [[...], [...], [...]], "T": [tx, ty, tz],
+     "uncertainty": {...}}      # optional: see measure.calibration_uncertainty
 
 ``R`` and ``T`` (metres) map left-camera coordinates into the right camera,
 ``X_right = R @ X_left + T``, exactly as ``cv2.stereoCalibrate`` returns them. Both
@@ -25,6 +26,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from measure.calibration_uncertainty import CalibrationUncertainty
 from measure.errors import CalibrationError
 
 #: undistortion iterations: converged far below a micro-pixel for any realistic lens
@@ -55,6 +57,8 @@ class StereoCalibration:
         dist_left, dist_right: distortion ``(k1, k2, p1, p2, k3)`` (OpenCV order).
         R, T: ``X_right = R @ X_left + T`` with ``T`` in metres.
         source: where the calibration came from (file path), for error messages.
+        uncertainty: one-sigma uncertainties of the parameters, when the calibration that
+            wrote the file estimated them (``None`` otherwise).
     """
 
     image_size: tuple[int, int]
@@ -65,6 +69,7 @@ class StereoCalibration:
     R: np.ndarray
     T: np.ndarray
     source: str = field(default="<memory>", compare=False)
+    uncertainty: CalibrationUncertainty | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         _validate(self)
@@ -111,17 +116,25 @@ class StereoCalibration:
             R=_array(data, "R", (3, 3), source),
             T=_array(data, "T", (3,), source),
             source=source,
+            uncertainty=(
+                CalibrationUncertainty.from_dict(data["uncertainty"], source)
+                if "uncertainty" in data
+                else None
+            ),
         )
 
     def to_dict(self) -> dict[str, Any]:
         """The ``stereo.json`` dictionary (plain lists, SI units)."""
-        return {
+        out: dict[str, Any] = {
             "image_size": [int(self.image_size[0]), int(self.image_size[1])],
             "left": {"K": self.K_left.tolist(), "dist": self.dist_left.tolist()},
             "right": {"K": self.K_right.tolist(), "dist": self.dist_right.tolist()},
             "R": self.R.tolist(),
             "T": self.T.tolist(),
         }
+        if self.uncertainty is not None:
+            out["uncertainty"] = self.uncertainty.to_dict()
+        return out
 
     def save(self, path: str | Path) -> None:
         """Write ``stereo.json`` (atomically: a temporary file renamed over the target)."""

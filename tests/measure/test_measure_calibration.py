@@ -83,3 +83,35 @@ def test_image_size_mismatch():
     st = standard_stereo()
     with pytest.raises(CalibrationError, match="2448x2048"):
         st.check_image((512, 640), "left")
+
+
+def test_uncertainty_block_round_trips_and_bad_values_name_the_field(tmp_path):
+    import json
+
+    from measure.calibration import StereoCalibration
+    from measure.errors import CalibrationError
+    from measure.synth import standard_stereo
+
+    cal = standard_stereo()
+    data = cal.to_dict()
+    data["uncertainty"] = {
+        "left": {"K_std_px": [0.5, 0.5, 0.3, 0.3], "dist_std": [1e-3, 1e-2, 1e-5, 1e-5, 0.05]},
+        "right": {"K_std_px": [0.6, 0.6, 0.4, 0.4], "dist_std": [1e-3, 1e-2, 1e-5, 1e-5, 0.05]},
+        "rvec_std_rad": [1e-4, 2e-4, 1e-4],
+        "T_std_m": [2e-5, 1e-5, 4e-5],
+        "rms_px": 0.2,
+        "per_view_rms_px": [[0.2, 0.21], [0.19, 0.2]],
+    }
+    path = tmp_path / "stereo.json"
+    path.write_text(json.dumps(data))
+    loaded = StereoCalibration.load(path)
+    assert loaded.uncertainty is not None
+    assert loaded.uncertainty.T_std_m[2] == 4e-5
+    loaded.save(tmp_path / "again.json")
+    assert json.loads((tmp_path / "again.json").read_text())["uncertainty"] == data["uncertainty"]
+    assert StereoCalibration.from_dict(cal.to_dict()).uncertainty is None
+
+    data["uncertainty"]["right"]["K_std_px"] = [0.6, -1, 0.4, 0.4]
+    path.write_text(json.dumps(data))
+    with pytest.raises(CalibrationError, match=r"uncertainty\.right\.K_std_px"):
+        StereoCalibration.load(path)
