@@ -44,3 +44,32 @@ class JointVectorError(RobotModelError):
         self.q = q
         self.expected = expected
         super().__init__(f"joint vector {q!r} must hold {expected} finite values (rad)")
+
+
+class NotOpwError(RobotModelError):
+    """A kinematic chain is not ortho-parallel with a spherical wrist (the OPW family)."""
+
+    def __init__(self, joint: str, prop: str) -> None:
+        self.joint = joint
+        self.prop = prop
+        super().__init__(f"not an ortho-parallel arm with a spherical wrist: {joint}: {prop}")
+
+
+class LimitsError(RobotModelError):
+    """Joint limits asked of an arm widen its URDF's limits or are malformed."""
+
+    def __init__(self, joint: str, reason: str) -> None:
+        self.joint = joint
+        self.reason = reason
+        super().__init__(f"{joint}: {reason}")
+
+
+class MeshError(RobotModelError):
+    """A collision mesh of a URDF link is missing or cannot be read."""
+
+    def __init__(self, urdf: str, link: str, path: str, reason: str) -> None:
+        self.urdf = urdf
+        self.link = link
+        self.path = path
+        self.reason = reason
+        super().__init__(f"{urdf}: link {link!r}: collision mesh {path}: {reason}")

@@ -1,14 +1,16 @@
-"""Closed-form inverse kinematics of the ABB six-axis arms (spherical wrist).
+"""Closed-form inverse kinematics of ortho-parallel arms with a spherical wrist (OPW family).
 
-The wrist centre ``p_w = p_tool0 - d6 * z_tool0`` fixes joints 1-3: J1 points
-the arm plane at the wrist centre (front) or away from it (back, J1 + pi); in
-that plane the upper arm (a2) and the forearm (d4 with the a3 step) form a
-triangle with two elbow solutions. The wrist orientation
-``R_3_6 = Rz(q4) Ry(-q5) Rz(q6 + pi)`` (from the D-H table) gives two wrist
-solutions (flip: q4 + pi, -q5, q6 + pi). That is up to 8 branches, numbered
-``4 * back + 2 * elbow_down + wrist_flip``; every joint value 2*pi apart that
-lies within the limits is returned too. Every solution is checked by forward
-kinematics (position 1e-9 m, orientation 1e-9 rad).
+Works on the canonical OPW chain of :mod:`robots.opw` (parameters a1, a2, b, c1..c4, joint
+signs and offsets, derived from the URDF). The wrist centre ``p_c = p_E - c4 * z_E`` fixes
+joints 1-3: J1 turns the arm plane to the wrist centre (front) or away from it (back); in that
+plane the upper arm (c2) and the forearm (a2, c3) form a triangle with two elbow solutions.
+The wrist orientation ``Rz(q4) Ry(q5) Rz(q6)`` gives two wrist solutions (flip: q4 + pi, -q5,
+q6 + pi). That is up to 8 branches, numbered ``4 * back + 2 * elbow + wrist_flip``; every
+joint value 2*pi apart that lies within the limits is returned too. Every solution is checked
+by forward kinematics (position 1e-9 m, orientation 1e-9 rad).
+
+:func:`solve_ik` takes a D-H table of the ABB layout (:mod:`robots.dh`) and solves it through
+the same OPW solver; :func:`solve_opw` takes OPW parameters of any arm of the family.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robots.dh import DHTable, fk_dh
+from robots.opw import OpwParameters, fk_opw
 
 Array = NDArray[np.float64]
 
@@ -33,6 +36,9 @@ SHOULDER_SINGULAR_TOL_M = 1e-9
 #: forward kinematics must reproduce the target to within these
 POSITION_TOL_M = 1e-9
 ORIENTATION_TOL = 1e-9
+#: the ABB D-H layout: alpha and theta offsets (rad)
+ABB_ALPHA = (-math.pi / 2, 0.0, -math.pi / 2, math.pi / 2, -math.pi / 2, 0.0)
+ABB_THETA_OFFSET = (0.0, -math.pi / 2, 0.0, 0.0, 0.0, math.pi)
 
 
 @dataclass(frozen=True)
@@ -57,69 +63,108 @@ class IKResult:
         return len(self.solutions) > 0
 
 
+
 @dataclass(frozen=True)
 class _Geometry:
-    a1: float
-    a2: float
-    a3: float
-    d1: float
-    d4: float
-    d6: float
+    """The numbers the hot loop needs, as plain floats."""
 
-    @classmethod
-    def of(cls, table: DHTable) -> _Geometry:
-        return _geometry_of(table)
+    a1: float
+    b: float
+    c1: float
+    c2: float
+    c4: float
+    kappa: float
+    psi: float
+    sign: tuple[float, ...]
+    offset: tuple[float, ...]
+    R_tool0_E: tuple[tuple[float, ...], ...]
+    p_tool0_E: tuple[float, ...]
 
 
 @lru_cache(maxsize=64)
-def _geometry_of(table: DHTable) -> _Geometry:
+def _geometry_of(params: OpwParameters) -> _Geometry:
+    T_tool0_E = np.linalg.inv(params.tool())
+    return _Geometry(
+        a1=params.a1,
+        b=params.b,
+        c1=params.c1,
+        c2=params.c2,
+        c4=params.c4,
+        kappa=math.hypot(params.a2, params.c3),
+        psi=math.atan2(params.a2, params.c3),
+        sign=params.sign,
+        offset=params.offset_rad,
+        R_tool0_E=tuple(tuple(r) for r in T_tool0_E[:3, :3].tolist()),
+        p_tool0_E=tuple(T_tool0_E[:3, 3].tolist()),
+    )
+
+
+def opw_of_abb_table(table: DHTable) -> OpwParameters:
+    """OPW parameters of a D-H table with the ABB layout (alpha, theta offsets of ABB_*)."""
+    return _opw_of_abb_table(table)
+
+
+@lru_cache(maxsize=64)
+def _opw_of_abb_table(table: DHTable) -> OpwParameters:
     a, d = table.a_m, table.d_m
-    return _Geometry(a1=a[0], a2=a[1], a3=a[2], d1=d[0], d4=d[3], d6=d[5])
+    layout = np.allclose(table.alpha_rad, ABB_ALPHA, atol=1e-12) and np.allclose(
+        table.theta_offset_rad, ABB_THETA_OFFSET, atol=1e-12
+    )
+    if not layout or any(abs(v) > 0 for v in (a[3], a[4], a[5], d[1], d[2], d[4])):
+        raise ValueError("solve_ik takes a D-H table of the ABB layout; use solve_opw otherwise")
+    # ABB: forearm along +x at q = 0 (canonical J3 offset pi/2), forearm step a3 above J3
+    return OpwParameters(
+        a1=a[0],
+        a2=-a[2],
+        b=0.0,
+        c1=d[0],
+        c2=a[1],
+        c3=d[3],
+        c4=d[5],
+        sign=(1.0,) * 6,
+        offset_rad=(0.0, 0.0, math.pi / 2, 0.0, 0.0, 0.0),
+        T_E_tool0=tuple(tuple(r) for r in np.eye(4).tolist()),
+        joint_names=("joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6"),
+    )
 
 
-def _arm_solutions(g: _Geometry, p_w: Array) -> tuple[list[tuple[float, float, float, int]], str]:
-    """Joint 1-3 solutions ``(q1, q2, q3, branch_base)`` for a wrist centre (m)."""
-    px, py, pz = float(p_w[0]), float(p_w[1]), float(p_w[2])
-    rho = math.hypot(px, py)
-    if rho < SHOULDER_SINGULAR_TOL_M:
-        return [], "shoulder singular"
-    L2 = g.d4 * g.d4 + g.a3 * g.a3
-    L = math.sqrt(L2)
-    phi = math.atan2(g.d4, g.a3)
+def _arm_solutions(g: _Geometry, p_c: list[float]) -> tuple[list[tuple[float, float, float, int]], str]:
+    """Canonical joint 1-3 solutions ``(q1, q2, q3, branch_base)`` for a wrist centre (m)."""
+    cx, cy, cz = p_c
+    rho2 = cx * cx + cy * cy - g.b * g.b
+    if math.hypot(cx, cy) < SHOULDER_SINGULAR_TOL_M or rho2 < SHOULDER_SINGULAR_TOL_M**2:
+        return [], "shoulder singular" if g.b == 0.0 else "out of reach"
+    x = math.sqrt(rho2)
+    base_angle = math.atan2(cy, cx)
+    h = cz - g.c1
     out = []
-    base_angle = math.atan2(py, px)
     for back in (0, 1):
-        q1 = base_angle + math.pi * back
-        r = (-rho if back else rho) - g.a1
-        h = pz - g.d1
-        k = (r * r + h * h - g.a2 * g.a2 - L2) / (2.0 * g.a2 * L)
+        xs = -x if back else x
+        q1 = base_angle - math.atan2(g.b, xs)
+        r = xs - g.a1
+        k = (r * r + h * h - g.c2 * g.c2 - g.kappa * g.kappa) / (2.0 * g.c2 * g.kappa)
         if abs(k) > 1.0:
             continue
         acos_k = math.acos(k)
+        reach = math.atan2(r, h)
         for elbow in (0, 1):
-            q3 = (acos_k if elbow else -acos_k) - phi
-            s3, c3 = math.sin(q3), math.cos(q3)
-            ux = g.d4 * c3 + g.a3 * s3
-            uz = g.a2 - g.d4 * s3 + g.a3 * c3
-            q2 = math.atan2(r, h) - math.atan2(ux, uz)
-            out.append((q1, q2, q3, 4 * back + 2 * elbow))
+            beta = -acos_k if elbow else acos_k
+            q2 = reach - math.atan2(g.kappa * math.sin(beta), g.c2 + g.kappa * math.cos(beta))
+            out.append((q1, q2, beta - g.psi, 4 * back + 2 * elbow))
     return out, "out of reach"
 
 
-def _wrist_solutions(
-    q1: float, q23: float, R: list[list[float]]
-) -> list[tuple[float, float, float, int]]:
-    """Joint 4-6 solutions ``(q4, q5, q6, flip)``; empty when the wrist is singular.
+def _wrist(q1: float, q23: float, R: list[list[float]]) -> list[tuple[float, float, float, int]]:
+    """Canonical joint 4-6 solutions ``(q4, q5, q6, flip)``; empty when the wrist is singular.
 
-    ``M = R_0_3^T R`` with ``R_0_3 = Rz(q1) Ry(q2 + q3) [[0,0,1],[0,-1,0],[1,0,0]]`` (the
-    orientation of D-H frame 3) and ``R`` the target orientation, as nested lists. Only the five
-    entries of ``M`` that the angles need are formed, in plain floats (this is the hot loop).
+    ``M = R_0c^T R`` with ``R_0c = Rz(q1) Ry(q23)`` and ``R`` the end frame's orientation, as
+    nested lists; only the five entries of ``M`` the ZYZ angles need are formed (the hot loop).
     """
     c1, s1, c23, s23 = math.cos(q1), math.sin(q1), math.cos(q23), math.sin(q23)
-    x0, x1, x2 = c1 * s23, s1 * s23, c23  # column 0 of R_0_3
-    z0, z1, z2 = c1 * c23, s1 * c23, -s23  # column 2 of R_0_3
+    x0, x1, x2 = c1 * c23, s1 * c23, -s23  # column 0 of R_0c
+    z0, z1, z2 = c1 * s23, s1 * s23, c23  # column 2 of R_0c
     m02 = x0 * R[0][2] + x1 * R[1][2] + x2 * R[2][2]
-    m12 = s1 * R[0][2] - c1 * R[1][2]  # column 1 of R_0_3 is (s1, -c1, 0)
+    m12 = -s1 * R[0][2] + c1 * R[1][2]  # column 1 of R_0c is (-s1, c1, 0)
     m22 = z0 * R[0][2] + z1 * R[1][2] + z2 * R[2][2]
     m20 = z0 * R[0][0] + z1 * R[1][0] + z2 * R[2][0]
     m21 = z0 * R[0][1] + z1 * R[1][1] + z2 * R[2][1]
@@ -127,39 +172,64 @@ def _wrist_solutions(
     if s5_abs < WRIST_SINGULAR_TOL:
         return []
     q5 = math.atan2(s5_abs, m22)
-    q4 = math.atan2(-m12, -m02)
-    q6 = math.atan2(-m21, m20) - math.pi
+    q4 = math.atan2(m12, m02)
+    q6 = math.atan2(m21, -m20)
     return [(q4, q5, q6, 0), (q4 + math.pi, -q5, q6 + math.pi, 1)]
 
 
-def solve_ik(table: DHTable, T_base_tool0: Array, lower: Array, upper: Array) -> IKResult:
-    """Every joint solution (rad) placing ``tool0`` at ``T_base_tool0`` within ``[lower, upper]``.
+def _wrist_solutions(
+    q1: float, q23: float, R: list[list[float]]
+) -> list[tuple[float, float, float, int]]:
+    """Joint 4-6 solutions of an ABB arm for its J1 and J2 + J3 (URDF values) and tool0's ``R``."""
+    return _wrist(q1, q23 + math.pi / 2, R)
 
-    The table must have the nominal ABB alpha and theta offsets (lengths may differ).
-    """
-    g = _geometry_of(table)
-    R = T_base_tool0[:3, :3]
-    p_w = T_base_tool0[:3, 3] - g.d6 * R[:, 2]
-    arm, arm_reason = _arm_solutions(g, p_w)
-    R_list = R.tolist()
+
+def _end_pose(g: _Geometry, T: Array) -> tuple[list[list[float]], list[float]]:
+    """The canonical end frame E (rotation as nested lists, position) for ``T_base_tool0``."""
+    R_t, p_t = T[:3, :3].tolist(), T[:3, 3].tolist()
+    Rq, pq = g.R_tool0_E, g.p_tool0_E
+    R = [[sum(R_t[i][k] * Rq[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    p = [p_t[i] + sum(R_t[i][k] * pq[k] for k in range(3)) for i in range(3)]
+    return R, p
+
+
+def solve_opw(params: OpwParameters, T_base_tool0: Array, lower: Array, upper: Array) -> IKResult:
+    """Every joint solution (URDF rad) placing ``tool0`` at ``T_base_tool0`` within limits."""
+    g = _geometry_of(params)
+    R, p = _end_pose(g, np.asarray(T_base_tool0, float))
+    p_c = [p[i] - g.c4 * R[i][2] for i in range(3)]
+    arm, arm_reason = _arm_solutions(g, p_c)
     if not arm:
         return _empty(arm_reason, 0)
     raw: list[tuple[float, ...]] = []
     branches: list[int] = []
     for q1, q2, q3, branch in arm:
-        for q4, q5, q6, flip in _wrist_solutions(q1, q2 + q3, R_list):
+        for q4, q5, q6, flip in _wrist(q1, q2 + q3, R):
             raw.append((q1, q2, q3, q4, q5, q6))
             branches.append(branch + flip)
     if not raw:
         return _empty("wrist singular", 0)
-    Q = np.array(raw)
-    keep = _verified(table, Q, T_base_tool0)
+    Q = (np.array(raw) - np.array(g.offset)) * np.array(g.sign)
+    keep = _verified(fk_opw(params, Q), T_base_tool0)
     if not keep.any():
         return _empty("out of reach", len(raw))
     sols, branch_ids = expand_within_limits(Q[keep], np.array(branches)[keep], lower, upper)
     if not len(sols):
         return _empty("outside limits", len(raw))
     return IKResult(sols, branch_ids, None, len(raw))
+
+
+def solve_ik(table: DHTable, T_base_tool0: Array, lower: Array, upper: Array) -> IKResult:
+    """Every joint solution (rad) placing ``tool0`` at ``T_base_tool0`` within ``[lower, upper]``.
+
+    The table must have the ABB layout (alpha and theta offsets of ``ABB_*``, lengths may
+    differ); solutions are also checked against the table's own forward kinematics.
+    """
+    result = solve_opw(opw_of_abb_table(table), T_base_tool0, lower, upper)
+    if result.ok:
+        ok = _verified(fk_dh(table, result.solutions), T_base_tool0)
+        return IKResult(result.solutions[ok], result.branches[ok], result.reason, result.n_branches)
+    return result
 
 
 def expand_within_limits(
@@ -192,8 +262,7 @@ def _shift_grid(lower: tuple[float, ...], upper: tuple[float, ...]) -> tuple[Arr
     return grid, np.array(lower) - 1e-12, np.array(upper) + 1e-12
 
 
-def _verified(table: DHTable, Q: Array, T_target: Array) -> NDArray[np.bool_]:
-    T = fk_dh(table, Q)
+def _verified(T: Array, T_target: Array) -> NDArray[np.bool_]:
     pos_err = np.linalg.norm(T[:, :3, 3] - T_target[:3, 3], axis=1)
     rot_err = np.abs(T[:, :3, :3] - T_target[:3, :3]).max(axis=(1, 2))
     return (pos_err < POSITION_TOL_M) & (rot_err < ORIENTATION_TOL)
