@@ -19,7 +19,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator
 
 from cell.errors import ConfigError
-from robots import DEFAULT_MODEL, Arm, LimitScaling, RobotModelError, Shape
+from robots import DEFAULT_MODEL, Arm, LimitScaling, LimitsError, RobotModelError, Shape
 from robots.transforms import pose_to_matrix
 
 DATA_DIR = Path(__file__).parent / "data"
@@ -115,10 +115,15 @@ class ShapeSpec(_Strict):
         return Shape(kind, (dims.radius, dims.length), T, name)
 
 
+JointRange = Annotated[list[float], Field(min_length=2, max_length=2)]
+
+
 class Limits(_Strict):
     velocity_scale: Annotated[float, Field(gt=0, le=1)] = 1.0
     acceleration_scale: Annotated[float, Field(gt=0, le=1)] = 1.0
     jerk_scale: Annotated[float, Field(gt=0, le=1)] = 1.0
+    #: [[lower, upper] x 6] rad narrowing the URDF's joint limits (a widening is refused)
+    position: Annotated[list[JointRange], Field(min_length=6, max_length=6)] | None = None
 
 
 class Robot(_Strict):
@@ -126,6 +131,8 @@ class Robot(_Strict):
     base: Pose = IDENTITY
     home: Annotated[list[float], Field(min_length=6, max_length=6)]
     limits: Limits = Limits()
+    #: folders (relative to the cell file) searched first for package:// mesh URIs
+    package_paths: list[str] = []
 
 
 class Tool(_Strict):
@@ -239,14 +246,36 @@ class CellConfig(_Strict):
         env = [s.to_shape(np.eye(4), f"env{i}") for i, s in enumerate(self.environment.obstacles)]
         return part + env
 
-    def build_arm(self) -> Arm:
-        """The arm with its base pose, limit scaling, tool and every obstacle attached."""
+    def _relative_to_cell(self, path: str) -> Path:
+        p = Path(path).expanduser()
+        if not p.is_absolute() and self._source_path is not None:
+            p = self._source_path.parent / p
+        return p
+
+    def robot_model(self) -> str:
+        """``robot.model``: a built-in name, or its URDF path resolved against the cell's folder."""
+        model = self.robot.model
+        return str(self._relative_to_cell(model).resolve()) if model.endswith(".urdf") else model
+
+    def package_paths(self) -> list[Path]:
+        """``robot.package_paths`` resolved against the cell file's folder."""
+        return [self._relative_to_cell(p) for p in self.robot.package_paths]
+
+    def build_robot(self) -> Arm:
+        """The bare arm: model, base pose, limits and their scaling (no tool, no obstacles)."""
         lim = self.robot.limits
         scaling = LimitScaling(lim.velocity_scale, lim.acceleration_scale, lim.jerk_scale)
-        model = self.robot.model
-        if self._source_path is not None and model.endswith(".urdf"):
-            model = str((self._source_path.parent / model).resolve())
-        arm = Arm(model, T_cell_base=self.T_cell_base(), scaling=scaling)
+        return Arm(
+            self.robot_model(),
+            T_cell_base=self.T_cell_base(),
+            scaling=scaling,
+            package_paths=self.package_paths(),
+            position_limits=lim.position,
+        )
+
+    def build_arm(self) -> Arm:
+        """The arm with its base pose, limit scaling, tool and every obstacle attached."""
+        arm = self.build_robot()
         arm.set_tool(self.T_tool0_tcp(), self.tool_shapes())
         arm.add_obstacles(self.obstacle_shapes())
         return arm
@@ -300,6 +329,8 @@ def _duplicate_ids(cfg: CellConfig) -> list[tuple[str, object, str]]:
 def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
     try:
         arm = cfg.build_arm()
+    except LimitsError as exc:
+        return [("robot.limits.position", cfg.robot.limits.position, str(exc))]
     except RobotModelError as exc:
         return [("robot.model", cfg.robot.model, str(exc))]
     q = cfg.home_q()

@@ -1,9 +1,13 @@
-"""ABB arm models: URDF, Pinocchio model, kinematics, collision and thermal error model."""
+"""Arm models: URDF, Pinocchio model, OPW kinematics, collision and thermal error model."""
 
 from robots.arm import Arm, LimitScaling, urdf_path
 from robots.dh import DHTable, dh_table, fk_dh
 from robots.errors import (
+    DHFormError,
     JointVectorError,
+    LimitsError,
+    MeshError,
+    NotOpwError,
     RobotModelError,
     ShapeError,
     UnknownModelError,
@@ -19,10 +23,14 @@ __all__ = [
     "MODELS",
     "Arm",
     "ArmSpec",
+    "DHFormError",
     "DHTable",
     "IKResult",
     "JointVectorError",
     "LimitScaling",
+    "LimitsError",
+    "MeshError",
+    "NotOpwError",
     "RobotModelError",
     "Shape",
     "ShapeError",

@@ -1,4 +1,4 @@
-"""The arm: a Pinocchio model of an ABB robot with its tool and the cell's obstacles.
+"""The arm: a Pinocchio model of a six-axis robot with its tool and the cell's obstacles.
 
 Frames: the cell frame is the world; the robot's ``base_link`` sits at
 ``T_cell_base`` in it. The tool is attached at ``tool0``; its TCP is
@@ -7,6 +7,7 @@ Frames: the cell frame is the world; the robot's ``base_link`` sits at
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -14,29 +15,27 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
+from robots.arm_kinematics import check_given_table, derive_kinematics
 from robots.collision import CollisionModel
-from robots.dh import DHTable, dh_table, fk_dh
+from robots.dh import DHTable, fk_dh
 from robots.errors import JointVectorError, UnknownModelError, UrdfError
-from robots.ik import IKResult, solve_ik
+from robots.ik import IKResult, solve_opw
+from robots.limits import narrowed_limits
 from robots.models import (
     ACCEL_PER_SPEED,
     DEFAULT_MODEL,
     JERK_PER_SPEED,
-    JOINT_NAMES,
     MODELS,
     ArmSpec,
 )
 from robots.shapes import Shape
 from robots.transforms import invert
+from robots.urdf_load import load_urdf
 from robots.urdf_writer import URDF_DIR
 
 Array = NDArray[np.float64]
 
 FRAMES = ("tcp", "tool0", "flange")
-#: ``tool0`` is ``flange`` (= link_6) turned +90 deg about y; this maps flange into tool0
-_T_TOOL0_FLANGE = np.array(
-    [[0.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0, 0, 0, 1.0]]
-)
 
 
 @dataclass(frozen=True)
@@ -48,64 +47,65 @@ class LimitScaling:
     jerk: float = 1.0
 
 
-def urdf_path(model: str) -> Path:
+def urdf_path(model: str | Path) -> Path:
     """Path of a built-in model's URDF, or ``model`` itself when it names a URDF file."""
-    if model in MODELS:
+    if str(model) in MODELS:
         return URDF_DIR / f"{model}.urdf"
     path = Path(model)
-    if path.suffix == ".urdf" and path.is_file():
+    if path.suffix == ".urdf":
+        if not path.is_file():
+            raise UrdfError(str(path), "no such file")
         return path
-    raise UnknownModelError(model, sorted(MODELS))
-
-
-def _load_pinocchio(path: Path) -> tuple[pin.Model, pin.GeometryModel]:
-    try:
-        model, collision, _visual = pin.buildModelsFromUrdf(str(path))
-    except (RuntimeError, ValueError) as exc:
-        raise UrdfError(str(path), f"cannot be read by Pinocchio: {exc}") from exc
-    names = list(model.names)[1:]
-    if tuple(names) != JOINT_NAMES:
-        raise UrdfError(str(path), f"expected joints {JOINT_NAMES}, found {tuple(names)}")
-    for frame in ("tool0", "flange"):
-        if not model.existFrame(frame):
-            raise UrdfError(str(path), f"has no frame {frame!r}")
-    return model, collision
+    raise UnknownModelError(str(model), sorted(MODELS))
 
 
 class Arm:
-    """An ABB arm in a cell: kinematics, limits, tool and collision checks.
+    """A six-axis arm in a cell: kinematics, limits, tool and collision checks.
+
+    Any ortho-parallel arm with a spherical wrist (the OPW family) is served from its URDF:
+    the IK parameters and the D-H rows are derived from the URDF's joint axes and checked
+    against its forward kinematics at load (:mod:`robots.arm_kinematics`).
 
     Args:
         model: a built-in model name (see :data:`robots.models.MODELS`) or a URDF path.
-            A foreign URDF needs the ABB joint layout and a matching built-in D-H table
-            for inverse kinematics (give it with ``dh``).
         T_cell_base: pose of ``base_link`` in the cell frame (4x4).
         scaling: scale factors on the velocity, acceleration and jerk limits.
-        dh: D-H table for inverse kinematics; defaults to the built-in model's.
+        dh: a D-H table to use instead of the derived one; refused unless it reproduces the
+            URDF (1e-9 m).
+        package_paths: folders searched first for ``package://`` mesh URIs.
+        position_limits: [[lo, hi] x 6] rad narrowing the URDF's limits (never widening).
     """
 
     def __init__(
         self,
-        model: str = DEFAULT_MODEL,
+        model: str | Path = DEFAULT_MODEL,
         T_cell_base: ArrayLike | None = None,
         scaling: LimitScaling | None = None,
         dh: DHTable | None = None,
+        package_paths: Sequence[str | Path] = (),
+        position_limits: ArrayLike | None = None,
     ) -> None:
         self.urdf_path = urdf_path(model)
-        self.spec: ArmSpec | None = MODELS.get(model)
-        self.model, self._robot_geoms = _load_pinocchio(self.urdf_path)
+        self.spec: ArmSpec | None = MODELS.get(str(model))
+        self.loaded = load_urdf(self.urdf_path, package_paths)
+        self.model, self._robot_geoms = self.loaded.model, self.loaded.collision
         self.data = self.model.createData()
-        if dh is None and self.spec is None:
-            raise UrdfError(str(self.urdf_path), "a foreign URDF needs a D-H table for IK (dh=...)")
-        self.dh = dh if dh is not None else dh_table(self.spec)
+        self.kinematics = derive_kinematics(self.loaded)
+        self.opw = self.kinematics.opw
         self.name = self.spec.name if self.spec else self.urdf_path.stem
-        self.joint_names = JOINT_NAMES
+        self.joint_names = self.loaded.joint_names
         self.nq = 6
         self.T_cell_base = np.eye(4) if T_cell_base is None else np.asarray(T_cell_base, float)
         self._T_base_cell = invert(self.T_cell_base)
         self.scaling = scaling or LimitScaling()
-        self.lower = self.model.lowerPositionLimit.copy()
-        self.upper = self.model.upperPositionLimit.copy()
+        self.urdf_lower = self.model.lowerPositionLimit.copy()
+        self.urdf_upper = self.model.upperPositionLimit.copy()
+        self.lower, self.upper = narrowed_limits(
+            self.joint_names, self.urdf_lower, self.urdf_upper, position_limits
+        )
+        if dh is not None:
+            check_given_table(self.loaded, dh, self.lower, self.upper)
+        self._dh = dh if dh is not None else self.kinematics.dh
         speed = self.model.velocityLimit.copy()
         self.velocity_limit = speed * self.scaling.velocity
         self.acceleration_limit = ACCEL_PER_SPEED * speed * self.scaling.acceleration
@@ -114,8 +114,16 @@ class Arm:
         self._T_tcp_tool0 = np.eye(4)
         self.tool_shapes: list[Shape] = []
         self.obstacles: list[Shape] = []
-        self._frame_ids = {f: self.model.getFrameId(f) for f in ("tool0", "flange")}
+        self._frame_ids = {"tool0": self.model.getFrameId("tool0")}
+        self._T_tool0_flange = self.loaded.T_tool0_flange
         self._collision: CollisionModel | None = None
+
+    @property
+    def dh(self) -> DHTable:
+        """The D-H table of the thermal model (derived from the URDF), or a RobotModelError."""
+        if self._dh is None:
+            raise UrdfError(str(self.urdf_path), f"no D-H table: {self.kinematics.dh_problem}")
+        return self._dh
 
     # -- configuration of the cell -------------------------------------------------------
     def set_tool(self, T_tool0_tcp: ArrayLike, shapes: list[Shape] | None = None) -> None:
@@ -159,9 +167,10 @@ class Arm:
             raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
         arr = self.check_q(q)
         pin.framesForwardKinematics(self.model, self.data, arr)
-        fid = self._frame_ids["flange" if frame == "flange" else "tool0"]
-        T = self.T_cell_base @ self.data.oMf[fid].homogeneous
-        return T @ self.T_tool0_tcp if frame == "tcp" else T
+        T = self.T_cell_base @ self.data.oMf[self._frame_ids["tool0"]].homogeneous
+        if frame == "tcp":
+            return T @ self.T_tool0_tcp
+        return T @ self._T_tool0_flange if frame == "flange" else T
 
     def fk_dh(self, q: ArrayLike, frame: str = "tcp") -> Array:
         """Like :meth:`fk` but from the D-H table; ``q`` may be (N, 6) for (N, 4, 4)."""
@@ -170,12 +179,12 @@ class Arm:
         T = self.T_cell_base @ fk_dh(self.dh, q)
         if frame == "tcp":
             return T @ self.T_tool0_tcp
-        return T @ _T_TOOL0_FLANGE if frame == "flange" else T
+        return T @ self._T_tool0_flange if frame == "flange" else T
 
     def ik(self, T_cell_tcp: ArrayLike) -> IKResult:
         """Every joint solution placing the TCP at ``T_cell_tcp`` (see :mod:`robots.ik`)."""
         T_base_tool0 = self._T_base_cell @ np.asarray(T_cell_tcp, float) @ self._T_tcp_tool0
-        return solve_ik(self.dh, T_base_tool0, self.lower, self.upper)
+        return solve_opw(self.opw, T_base_tool0, self.lower, self.upper)
 
     # -- collision ---------------------------------------------------------------------------
     def in_collision(self, q: ArrayLike) -> bool:

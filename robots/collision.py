@@ -92,7 +92,9 @@ class CollisionModel:
 
     def _candidate_pairs(self) -> list[tuple[int, int]]:
         pairs = []
-        order = {body: k for k, body in enumerate(CHAIN_BODIES)}
+        # chain position of a body: its moving joint's index (any URDF's link names); tool last
+        order = {f.name: int(f.parentJoint) for f in self.model.frames}
+        order["tool"] = self.model.njoints
         for i, a in enumerate(self.infos):
             for j in range(i + 1, len(self.infos)):
                 b = self.infos[j]

@@ -1,4 +1,4 @@
-"""Classic (distal) Denavit-Hartenberg tables of the ABB models.
+"""Classic (distal) Denavit-Hartenberg tables: the ABB models' and any OPW arm's.
 
 Link i maps frame i-1 to frame i by ``Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``
 with ``theta_i = q_i + theta_offset_i``. Frame 0 is ``base_link``; frame 6 is
@@ -11,11 +11,11 @@ with ``theta_i = q_i + theta_offset_i``. Frame 0 is ``base_link``; frame 6 is
 
 The thermal model (:mod:`robots.thermal`) scales ``a`` and ``d`` and adds
 offsets to ``theta``; so forward kinematics takes the table as an argument.
+Tables are derived from the URDF (:mod:`robots.dh_derive`), never kept by hand.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
@@ -25,8 +25,6 @@ from numpy.typing import ArrayLike, NDArray
 from robots.models import MODELS, ArmSpec
 
 Array = NDArray[np.float64]
-
-_PI = math.pi
 
 
 @dataclass(frozen=True)
@@ -57,15 +55,25 @@ class DHTable:
 
 
 def dh_table(spec: ArmSpec | str) -> DHTable:
-    """The D-H table of a built-in model (by spec or name)."""
-    if isinstance(spec, str):
-        spec = MODELS[spec]
-    return DHTable(
-        a_m=(spec.a1, spec.a2, spec.a3, 0.0, 0.0, 0.0),
-        d_m=(spec.d1, 0.0, 0.0, spec.d4, 0.0, spec.d6),
-        alpha_rad=(-_PI / 2, 0.0, -_PI / 2, _PI / 2, -_PI / 2, 0.0),
-        theta_offset_rad=(0.0, -_PI / 2, 0.0, 0.0, 0.0, _PI),
-    )
+    """The D-H table of a built-in model (by spec or name), derived from its URDF.
+
+    Same derivation as for any URDF (:mod:`robots.dh_derive` from the OPW parameters of
+    :mod:`robots.opw`), so the table cannot disagree with the URDF.
+    """
+    return _builtin_table(spec if isinstance(spec, str) else spec.name)
+
+
+@lru_cache(maxsize=8)
+def _builtin_table(name: str) -> DHTable:
+    from robots.arm_kinematics import derive_kinematics
+    from robots.urdf_load import load_urdf
+    from robots.urdf_writer import URDF_DIR
+
+    if name not in MODELS:
+        raise KeyError(name)
+    table = derive_kinematics(load_urdf(URDF_DIR / f"{name}.urdf")).dh
+    assert table is not None  # the built-in chains have the ABB layout
+    return table
 
 
 @lru_cache(maxsize=64)

@@ -73,3 +73,12 @@ class MeshError(RobotModelError):
         self.path = path
         self.reason = reason
         super().__init__(f"{urdf}: link {link!r}: collision mesh {path}: {reason}")
+
+
+class DHFormError(RobotModelError):
+    """An arm's chain has no D-H table of the form the thermal model uses (frame 0 = base_link)."""
+
+    def __init__(self, joint: str, reason: str) -> None:
+        self.joint = joint
+        self.reason = reason
+        super().__init__(f"{joint}: {reason}")

@@ -63,7 +63,6 @@ class IKResult:
         return len(self.solutions) > 0
 
 
-
 @dataclass(frozen=True)
 class _Geometry:
     """The numbers the hot loop needs, as plain floats."""
@@ -77,8 +76,8 @@ class _Geometry:
     psi: float
     sign: tuple[float, ...]
     offset: tuple[float, ...]
-    R_tool0_E: tuple[tuple[float, ...], ...]
-    p_tool0_E: tuple[float, ...]
+    r_tool0_e: tuple[tuple[float, ...], ...]
+    p_tool0_e: tuple[float, ...]
 
 
 @lru_cache(maxsize=64)
@@ -94,8 +93,8 @@ def _geometry_of(params: OpwParameters) -> _Geometry:
         psi=math.atan2(params.a2, params.c3),
         sign=params.sign,
         offset=params.offset_rad,
-        R_tool0_E=tuple(tuple(r) for r in T_tool0_E[:3, :3].tolist()),
-        p_tool0_E=tuple(T_tool0_E[:3, 3].tolist()),
+        r_tool0_e=tuple(tuple(r) for r in T_tool0_E[:3, :3].tolist()),
+        p_tool0_e=tuple(T_tool0_E[:3, 3].tolist()),
     )
 
 
@@ -128,7 +127,9 @@ def _opw_of_abb_table(table: DHTable) -> OpwParameters:
     )
 
 
-def _arm_solutions(g: _Geometry, p_c: list[float]) -> tuple[list[tuple[float, float, float, int]], str]:
+def _arm_solutions(
+    g: _Geometry, p_c: list[float]
+) -> tuple[list[tuple[float, float, float, int]], str]:
     """Canonical joint 1-3 solutions ``(q1, q2, q3, branch_base)`` for a wrist centre (m)."""
     cx, cy, cz = p_c
     rho2 = cx * cx + cy * cy - g.b * g.b
@@ -187,7 +188,7 @@ def _wrist_solutions(
 def _end_pose(g: _Geometry, T: Array) -> tuple[list[list[float]], list[float]]:
     """The canonical end frame E (rotation as nested lists, position) for ``T_base_tool0``."""
     R_t, p_t = T[:3, :3].tolist(), T[:3, 3].tolist()
-    Rq, pq = g.R_tool0_E, g.p_tool0_E
+    Rq, pq = g.r_tool0_e, g.p_tool0_e
     R = [[sum(R_t[i][k] * Rq[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
     p = [p_t[i] + sum(R_t[i][k] * pq[k] for k in range(3)) for i in range(3)]
     return R, p

@@ -121,7 +121,7 @@ def _unreadable_mesh(path: Path, meshes: dict[str, list[Path]], exc: Exception) 
         for f in files:
             try:
                 loader.load(str(f), np.ones(3))
-            except Exception as mesh_exc:  # noqa: BLE001 - coal raises plain exceptions
+            except Exception as mesh_exc:  # coal raises plain exceptions
                 return MeshError(str(path), link, str(f), f"cannot be read: {mesh_exc}")
     return UrdfError(str(path), f"cannot be read by Pinocchio: {exc}")
 

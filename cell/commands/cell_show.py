@@ -10,6 +10,7 @@ import numpy as np
 from cell.config import CellConfig, load_cell
 from cell.errors import CellError
 from cell.reach import hole_reach
+from robots import Arm
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -40,6 +41,7 @@ def _summary(cfg: CellConfig) -> list[str]:
         f"cell      {cfg.name}  ({cfg.source_path})",
         f"robot     {arm.name}  base xyz {base.xyz}  home {np.round(cfg.home_q(), 4).tolist()} rad",
         "          limits  vel " + " ".join(f"{v:.2f}" for v in arm.velocity_limit) + " rad/s",
+        *_robot_lines(arm),
         f"tool      tcp {cfg.tool.tool0_to_tcp.xyz} from tool0, standoff {cfg.tool.standoff_m} m, "
         f"{len(cfg.tool.shapes)} shapes",
         f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes, "
@@ -52,6 +54,21 @@ def _summary(cfg: CellConfig) -> list[str]:
             f"note      pairs touching at q=0, not checked: {arm.collision.excluded_pairs}"
         )
     return lines
+
+
+def _robot_lines(arm: Arm) -> list[str]:
+    """Where the arm came from: URDF, meshes, limits, the derived OPW parameters."""
+    k = arm.kinematics
+    n_meshes = sum(len(v) for v in arm.loaded.meshes.values())
+    lengths = " ".join(f"{name} {v:.4f}" for name, v in arm.opw.lengths().items())
+    pos = " ".join(f"[{lo:.3f}, {hi:.3f}]" for lo, hi in zip(arm.lower, arm.upper, strict=True))
+    return [
+        f"          urdf    {arm.urdf_path}  ({n_meshes} collision meshes)",
+        f"          limits  pos {pos} rad",
+        f"          OPW     {lengths} m; signs {[int(s) for s in arm.opw.sign]}; "
+        f"URDF vs OPW {k.fk_error_m:.1e} m over 128 configurations",
+        "          D-H     " + ("derived from the same axes" if k.dh else f"none: {k.dh_problem}"),
+    ]
 
 
 def run_show(args: argparse.Namespace) -> int:

@@ -126,12 +126,11 @@ def _help(parser: argparse.ArgumentParser) -> int:
     return 2
 
 
-def _table_of(model_name: str) -> DHTable:
-    if model_name in MODELS:
-        return dh_table(model_name)
-    from robots import Arm
-
-    return Arm(model_name).dh
+def _table_of(cfg: CellConfig) -> DHTable:
+    """The D-H table of the cell's arm (a URDF path is relative to the cell file's folder)."""
+    if cfg.robot.model in MODELS:
+        return dh_table(cfg.robot.model)
+    return cfg.build_robot().dh
 
 
 def _geometry(cfg: CellConfig, cell_arg: str) -> tuple[CellGeometry, str, DHTable]:
@@ -144,7 +143,7 @@ def _geometry(cfg: CellConfig, cell_arg: str) -> tuple[CellGeometry, str, DHTabl
         )
     targets = {t.id: np.asarray(t.position, float) for t in cfg.reference_targets}
     geometry = CellGeometry(cfg.T_cell_base(), cfg.T_tool0_tcp(), targets)
-    return geometry, cfg.robot.model, _table_of(cfg.robot.model)
+    return geometry, cfg.robot.model, _table_of(cfg)
 
 
 def _print_result(res: IdentificationResult, source: Path) -> None:

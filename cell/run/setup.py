@@ -21,7 +21,7 @@ from cell.run.runner import stop_rows
 from planner import Tour, TourCellMismatchError, check_tour_for_cell
 from planner.planner import cell_sha256
 from planner.tour import tour_from_dict
-from robots.models import JOINT_NAMES
+from robots.models import JOINT_NAMES, MODELS
 
 
 class TourMismatchError(CellError):
@@ -48,8 +48,9 @@ def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False
             check_tour_for_cell(tour, cell)
         except TourCellMismatchError as exc:
             raise TourMismatchError(where, exc.field, exc.tour_value, exc.cell_value) from exc
-    if tuple(tour.joint_names) != JOINT_NAMES:
-        raise TourMismatchError(where, "robot.joint_names", tour.joint_names, JOINT_NAMES)
+    names = JOINT_NAMES if cell.robot.model in MODELS else cell.build_robot().joint_names
+    if tuple(tour.joint_names) != tuple(names):
+        raise TourMismatchError(where, "robot.joint_names", tour.joint_names, names)
     traj = np.asarray(tour.trajectory)
     if traj.ndim != 2 or traj.shape[1] != 6 or len(traj) < 2:
         raise CellError(f"{where}: trajectory has shape {traj.shape}, expected (N >= 2, 6)")
