@@ -21,6 +21,7 @@ from robots.dh import DHTable, fk_dh
 from robots.errors import JointVectorError, UnknownModelError, UrdfError
 from robots.ik import IKResult, solve_opw
 from robots.limits import narrowed_limits
+from robots.opw import fk_opw
 from robots.models import (
     ACCEL_PER_SPEED,
     DEFAULT_MODEL,
@@ -173,10 +174,15 @@ class Arm:
         return T @ self._T_tool0_flange if frame == "flange" else T
 
     def fk_dh(self, q: ArrayLike, frame: str = "tcp") -> Array:
-        """Like :meth:`fk` but from the D-H table; ``q`` may be (N, 6) for (N, 4, 4)."""
+        """Like :meth:`fk` but closed-form and vectorised; ``q`` may be (N, 6) for (N, 4, 4).
+
+        From the D-H table; for a chain without a D-H form (J1 about -z) from the OPW
+        parameters, which the URDF check at load holds to the same 1e-9 m.
+        """
         if frame not in FRAMES:
             raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
-        T = self.T_cell_base @ fk_dh(self.dh, q)
+        T_base = fk_dh(self._dh, q) if self._dh is not None else fk_opw(self.opw, q)
+        T = self.T_cell_base @ T_base
         if frame == "tcp":
             return T @ self.T_tool0_tcp
         return T @ self._T_tool0_flange if frame == "flange" else T
