@@ -16,7 +16,7 @@ the same OPW solver; :func:`solve_opw` takes OPW parameters of any arm of the fa
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from itertools import product
 
@@ -24,7 +24,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from robots.dh import DHTable, fk_dh
-from robots.opw import OpwParameters, fk_opw
+from robots.dh_derive import dh_from_lines
+from robots.opw import OpwParameters, fk_opw, joint_lines_of
 
 Array = NDArray[np.float64]
 
@@ -65,37 +66,53 @@ class IKResult:
 
 @dataclass(frozen=True)
 class _Geometry:
-    """The numbers the hot loop needs, as plain floats."""
+    """The numbers the hot loop needs, as plain floats and ready arrays."""
 
     a1: float
+    a2: float
     b: float
     c1: float
     c2: float
+    c3: float
     c4: float
     kappa: float
     psi: float
-    sign: tuple[float, ...]
-    offset: tuple[float, ...]
-    r_tool0_e: tuple[tuple[float, ...], ...]
-    p_tool0_e: tuple[float, ...]
+    sign: Array
+    offset: Array
+    T_tool0_e: Array | None  # None when tool0 is the canonical end frame E
+    canonical_table: DHTable  # D-H rows of the canonical chain (base to E), for the FK check
 
 
 @lru_cache(maxsize=64)
 def _geometry_of(params: OpwParameters) -> _Geometry:
-    T_tool0_E = np.linalg.inv(params.tool())
+    T_E_tool0 = params.tool()
+    identity = bool(np.abs(T_E_tool0 - np.eye(4)).max() < 1e-15)
     return _Geometry(
         a1=params.a1,
+        a2=params.a2,
         b=params.b,
         c1=params.c1,
         c2=params.c2,
+        c3=params.c3,
         c4=params.c4,
         kappa=math.hypot(params.a2, params.c3),
         psi=math.atan2(params.a2, params.c3),
-        sign=params.sign,
-        offset=params.offset_rad,
-        r_tool0_e=tuple(tuple(r) for r in T_tool0_E[:3, :3].tolist()),
-        p_tool0_e=tuple(T_tool0_E[:3, 3].tolist()),
+        sign=np.array(params.sign, float),
+        offset=np.array(params.offset_rad, float),
+        T_tool0_e=None if identity else np.linalg.inv(T_E_tool0),
+        canonical_table=_canonical_table(params),
     )
+
+
+def _canonical_table(params: OpwParameters) -> DHTable:
+    """D-H rows of the canonical chain (signs +1, offsets 0, tool0 = E): a fast exact FK."""
+    canon = replace(
+        params,
+        sign=(1.0,) * 6,
+        offset_rad=(0.0,) * 6,
+        T_E_tool0=tuple(tuple(r) for r in np.eye(4).tolist()),
+    )
+    return dh_from_lines(joint_lines_of(canon), fk_opw(canon, np.zeros(6)))
 
 
 def opw_of_abb_table(table: DHTable) -> OpwParameters:
@@ -185,19 +202,13 @@ def _wrist_solutions(
     return _wrist(q1, q23 + math.pi / 2, R)
 
 
-def _end_pose(g: _Geometry, T: Array) -> tuple[list[list[float]], list[float]]:
-    """The canonical end frame E (rotation as nested lists, position) for ``T_base_tool0``."""
-    R_t, p_t = T[:3, :3].tolist(), T[:3, 3].tolist()
-    Rq, pq = g.r_tool0_e, g.p_tool0_e
-    R = [[sum(R_t[i][k] * Rq[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
-    p = [p_t[i] + sum(R_t[i][k] * pq[k] for k in range(3)) for i in range(3)]
-    return R, p
-
-
 def solve_opw(params: OpwParameters, T_base_tool0: Array, lower: Array, upper: Array) -> IKResult:
     """Every joint solution (URDF rad) placing ``tool0`` at ``T_base_tool0`` within limits."""
     g = _geometry_of(params)
-    R, p = _end_pose(g, np.asarray(T_base_tool0, float))
+    T = np.asarray(T_base_tool0, float)
+    T_E = T if g.T_tool0_e is None else T @ g.T_tool0_e
+    R = T_E[:3, :3].tolist()
+    p = T_E[:3, 3].tolist()
     p_c = [p[i] - g.c4 * R[i][2] for i in range(3)]
     arm, arm_reason = _arm_solutions(g, p_c)
     if not arm:
@@ -210,11 +221,12 @@ def solve_opw(params: OpwParameters, T_base_tool0: Array, lower: Array, upper: A
             branches.append(branch + flip)
     if not raw:
         return _empty("wrist singular", 0)
-    Q = (np.array(raw) - np.array(g.offset)) * np.array(g.sign)
-    keep = _verified(fk_opw(params, Q), T_base_tool0)
+    Qc = np.array(raw)
+    keep = _verified(fk_dh(g.canonical_table, Qc), T_E)
     if not keep.any():
         return _empty("out of reach", len(raw))
-    sols, branch_ids = expand_within_limits(Q[keep], np.array(branches)[keep], lower, upper)
+    Q = (Qc[keep] - g.offset) * g.sign
+    sols, branch_ids = expand_within_limits(Q, np.array(branches)[keep], lower, upper)
     if not len(sols):
         return _empty("outside limits", len(raw))
     return IKResult(sols, branch_ids, None, len(raw))
