@@ -292,6 +292,7 @@ def identify(
         robot_model=robot_model,
         T_cell_base=np.asarray(geometry.T_cell_base, float),
         T_tool0_tcp=np.asarray(geometry.T_tool0_tcp, float),
+        covariance=cov * np.outer(scale, scale),
         fit={
             "residual_rms_m": rms,
             "residual_rms_before_m": float(np.sqrt(np.mean(r0**2))),
