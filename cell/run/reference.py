@@ -67,7 +67,7 @@ def design_reference_plan(
         raise CellError(f"cell {cell.name!r} has no reference_targets for the thermal update")
     arm = cell.build_arm()
     targets = {r.id: (r.position, r.normal) for r in cell.reference_targets}
-    stops = hole_stops(cell) if stops_q is None else np.atleast_2d(np.asarray(stops_q, float))
+    stops = hole_stops(cell)[1] if stops_q is None else np.atleast_2d(np.asarray(stops_q, float))
     try:
         cands, skipped = candidate_views(
             arm.dh, arm.lower, arm.upper, cell.T_cell_base(), cell.T_tool0_tcp(), targets,
