@@ -38,21 +38,24 @@ def target_of(stop_id: str) -> str:
     return stop_id.split(VIEW_SEPARATOR, 1)[0]
 
 
-def hole_stops(cell: CellConfig, roll_step_deg: float = 15.0) -> NDArray[np.float64]:
-    """Stand-in stops when no tour is given (S, 6) rad: per hole, its collision-free viewpoint
-    configuration nearest home (the planner's candidates). Holes the arm cannot see are left
-    out."""
+def hole_stops(
+    cell: CellConfig, roll_step_deg: float = 15.0
+) -> tuple[list[str], NDArray[np.float64]]:
+    """Stand-in stops when no tour is given: hole ids and (S, 6) rad, per hole its
+    collision-free viewpoint configuration nearest home (the planner's candidates). Holes the
+    arm cannot see are left out."""
     arm, home = cell.build_arm(), cell.home_q()
-    out = []
+    ids, out = [], []
     for hole in cell.holes_in_cell():
         c = hole_candidates(arm, hole, cell.tool.standoff_m, roll_step_deg)
         if c.ok:
+            ids.append(hole.id)
             out.append(c.q[np.argmin(np.abs(c.q - home).sum(axis=1))])
     if not out:
         raise CellError(
             f"cell {cell.name!r}: no hole is reachable to design the reference plan for"
         )
-    return np.array(out)
+    return ids, np.array(out)
 
 
 def design_reference_plan(
