@@ -106,7 +106,9 @@ def _prepare(
     check_tour(tour, cell, args.tour)
     model = _thermal_model(args.thermal, cell)
     reference = (
-        plan_reference_tour(cell) if cell.reference_targets and args.reference_rounds else None
+        plan_reference_tour(cell, tour=tour)
+        if cell.reference_targets and args.reference_rounds
+        else None
     )
     return cell, model, lambda: start_run(out, cell, tour, args.tour, args.port, reference)
 

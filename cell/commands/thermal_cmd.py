@@ -3,6 +3,7 @@
     holecell thermal identify OBS.csv --cell CELL -o thermal.json
     holecell thermal predict thermal.json POSES.csv [-o OUT.csv] [--command]
     holecell thermal simulate --cell CELL -o OBS.csv   (warm-up observations of a simulated arm)
+    holecell thermal plan-views --cell CELL [--tour tour.json] -o views.csv   (thermal_plan_cmd)
 
 The CSV formats are described in :mod:`robots.thermal.csvio` and docs/thermal.md.
 """
@@ -37,7 +38,6 @@ from robots.thermal.compensate import compensated_T_cell_tcp
 from robots.thermal.csvio import read_observations, read_poses, write_observations
 from robots.thermal.errors import ThermalDataError
 from robots.thermal.modelfile import load_model, save_model
-from robots.thermal.plan import view_plan
 
 if TYPE_CHECKING:
     from cell.config import CellConfig
@@ -108,8 +108,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     sim = sub.add_parser(
         "simulate",
         help="observations of the cell's reference targets on a simulated warming arm",
-        description="Plans three views of every reference target of the cell (IK, collision "
-        "checked), simulates the reference warm-up (robots.thermal.default_settings: about "
+        description="Observes the reference views designed for the cell (or --views), "
+        "simulates the reference warm-up (robots.thermal.default_settings: about "
         "+15 K in two hours) and writes the observations CSV that 'thermal identify' reads.",
     )
     sim.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
@@ -118,7 +118,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     sim.add_argument("--every-s", type=float, default=300.0, help="period (s, default 300)")
     sim.add_argument("--noise-um", type=float, default=5.0, help="noise per axis (um, default 5)")
     sim.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    sim.add_argument(
+        "--views",
+        type=Path,
+        metavar="views.csv",
+        help="reference views to observe (from 'thermal plan-views'; default: the plan designed "
+        "for the cell's holes, as holecell run uses without a tour)",
+    )
     sim.set_defaults(handler=run_simulate)
+    from cell.commands import thermal_plan_cmd
+
+    thermal_plan_cmd.register(sub)
 
 
 def _help(parser: argparse.ArgumentParser) -> int:
@@ -270,20 +280,14 @@ def run_simulate(args: argparse.Namespace) -> int:
         )
     cfg = load_cell(args.cell)
     geometry, _, table = _geometry(cfg, args.cell)
-    arm = cfg.build_arm()
-    targets = {t.id: (t.position, t.normal) for t in cfg.reference_targets}
-    plan = view_plan(
-        table,
-        arm.lower,
-        arm.upper,
-        geometry.T_cell_base,
-        geometry.T_tool0_tcp,
-        targets,
-        cfg.tool.standoff_m,
-        accept=lambda q: not arm.in_collision(q),
-    )
-    for tid, k, reason in plan.skipped:
-        print(f"view {k} of {tid} skipped: {reason}", file=sys.stderr)
+    if args.views is not None:
+        from cell.commands.thermal_plan_cmd import read_views
+
+        poses = read_views(args.views, cfg)
+    else:
+        from cell.run.reference import design_reference_plan
+
+        poses = design_reference_plan(cfg).poses
     truth = DriftTruth(table, default_settings(), seed=args.seed)
     times = np.arange(0.0, args.hours * 3600.0 + 1e-9, args.every_s)
     obs = simulate_observations(
@@ -291,14 +295,13 @@ def run_simulate(args: argparse.Namespace) -> int:
         truth.sensor_readings,
         truth.settings.sensor_names,
         geometry,
-        plan.poses,
+        poses,
         times,
         noise_m=args.noise_um * 1e-6,
         seed=args.seed,
     )
     _write_atomic(args.output, lambda p: write_observations(p, obs))
     print(
-        f"wrote {len(obs)} observations ({len(plan.poses)} poses x {len(times)} times) "
-        f"to {args.output}"
+        f"wrote {len(obs)} observations ({len(poses)} poses x {len(times)} times) to {args.output}"
     )
     return 0

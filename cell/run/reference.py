@@ -1,22 +1,30 @@
 """The reference-target tour: the arm visits the cell's reference targets for the thermal update.
 
-Each target is seen from several views (the thermal model's recommended pose plan,
-:class:`robots.thermal.plan.ViewOptions`: the view axis tilted from the target normal toward
-several azimuths), because one view per target leaves the length terms nearly inseparable
-(``docs/thermal.md``). The planner plans a tour over these views exactly as over holes: each
-view becomes a pseudo-hole ``"<target>#<view>"`` whose normal is the reversed view axis.
+The views are the reference plan designed for the tour (:mod:`robots.thermal.design`): among
+every reachable, collision-free view of every target, those that minimise the thermal model's
+predicted error at the tour's stops (the hole tour's joint vectors when a tour is given, else
+each hole's collision-free viewpoint configuration nearest home). ``holecell thermal
+plan-views`` prints and writes the same plan (:func:`design_reference_plan`). The planner plans a
+tour through exactly these joint vectors: each view becomes a pseudo-hole ``"<target>#<view>"``
+(normal: the reversed view axis) whose only candidate is the designed configuration.
 """
 
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cell.config import CellConfig, Hole
 from cell.errors import CellError
-from planner import Options, Tour, plan_tour
-from robots.thermal.plan import ViewOptions, view_pose
+from planner import Options, Tour, TourPlanner
+from planner.protocols import ArmLike, CellLike
+from planner.tour import LeftOut
+from planner.viewpoints import HoleCandidates, hole_candidates
+from robots.thermal.design import Design, DesignOptions, candidate_views, design_views
+from robots.thermal.errors import ThermalError
 from robots.transforms import invert
 
 VIEW_SEPARATOR = "#"
@@ -30,54 +38,108 @@ def target_of(stop_id: str) -> str:
     return stop_id.split(VIEW_SEPARATOR, 1)[0]
 
 
-def reference_cell(cell: CellConfig, views: ViewOptions | None = None) -> CellConfig:
-    """A copy of ``cell`` whose part holes are the views of its reference targets (part frame)."""
+def hole_stops(
+    cell: CellConfig, roll_step_deg: float = 15.0
+) -> tuple[list[str], NDArray[np.float64]]:
+    """Stand-in stops when no tour is given: hole ids and (S, 6) rad, per hole its
+    collision-free viewpoint configuration nearest home (the planner's candidates). Holes the
+    arm cannot see are left out."""
+    arm, home = cell.build_arm(), cell.home_q()
+    ids, out = [], []
+    for hole in cell.holes_in_cell():
+        c = hole_candidates(arm, hole, cell.tool.standoff_m, roll_step_deg)
+        if c.ok:
+            ids.append(hole.id)
+            out.append(c.q[np.argmin(np.abs(c.q - home).sum(axis=1))])
+    if not out:
+        raise CellError(
+            f"cell {cell.name!r}: no hole is reachable to design the reference plan for"
+        )
+    return ids, np.array(out)
+
+
+def design_reference_plan(
+    cell: CellConfig,
+    stops_q: NDArray[np.float64] | None = None,
+    options: DesignOptions | None = None,
+) -> Design:
+    """The reference views designed for the stops ``stops_q`` (S, 6) rad (default
+    :func:`hole_stops`), under the cell's reach and collision; raises :class:`CellError` when
+    the cell has no reference target or none can be seen."""
     if not cell.reference_targets:
         raise CellError(f"cell {cell.name!r} has no reference_targets for the thermal update")
-    views = views or ViewOptions()
-    T_cell_base = cell.T_cell_base()
-    T_base_cell, T_part_cell = invert(T_cell_base), invert(cell.T_cell_part())
+    arm = cell.build_arm()
+    targets = {r.id: (r.position, r.normal) for r in cell.reference_targets}
+    stops = hole_stops(cell)[1] if stops_q is None else np.atleast_2d(np.asarray(stops_q, float))
+    try:
+        cands, skipped = candidate_views(
+            arm.dh, arm.lower, arm.upper, cell.T_cell_base(), cell.T_tool0_tcp(), targets,
+            cell.tool.standoff_m, options, accept=lambda q: not arm.in_collision(q),
+            rest_q=cell.home_q(),
+        )  # fmt: skip
+        design = design_views(
+            arm.dh, cell.T_cell_base(), cell.T_tool0_tcp(), cands, stops, options,
+            n_targets=len(targets),
+        )  # fmt: skip
+    except ThermalError as exc:
+        where = "; ".join(f"{t}: {r}" for t, r in skipped.items()) if "skipped" in locals() else ""
+        raise CellError(f"cell {cell.name!r}: {exc}" + (f" ({where})" if where else "")) from exc
+    return replace(design, skipped=skipped)
+
+
+def reference_cell(cell: CellConfig, design: Design) -> CellConfig:
+    """A copy of ``cell`` whose part holes are the designed views (pseudo-holes, part frame)."""
+    arm = cell.build_arm()
+    T_part_cell = invert(cell.T_cell_part())
     holes = []
-    for r in cell.reference_targets:
-        p_cell, n_cell = np.asarray(r.position, float), np.asarray(r.normal, float)
-        p_base = T_base_cell[:3, :3] @ p_cell + T_base_cell[:3, 3]
-        n_base = T_base_cell[:3, :3] @ n_cell
-        for k, (tilt, az) in enumerate(zip(views.tilts_rad, views.azimuths_rad, strict=True)):
-            z_base = view_pose(p_base, n_base, tilt, az, 0.0, cell.tool.standoff_m)[:3, 2]
-            n_part = T_part_cell[:3, :3] @ (T_cell_base[:3, :3] @ -z_base)
-            p_part = T_part_cell[:3, :3] @ p_cell + T_part_cell[:3, 3]
-            holes.append(
-                Hole(
-                    id=f"{r.id}{VIEW_SEPARATOR}{k}",
-                    position=p_part.tolist(),
-                    normal=(n_part / np.linalg.norm(n_part)).tolist(),
-                    diameter=r.diameter,
-                )
+    for k, view in enumerate(design.views):
+        target = next(r for r in cell.reference_targets if r.id == view.target_id)
+        z_cell = arm.fk(view.q_rad, "tcp")[:3, 2]
+        n_part = T_part_cell[:3, :3] @ -z_cell
+        p_part = T_part_cell[:3, :3] @ np.asarray(target.position, float) + T_part_cell[:3, 3]
+        holes.append(
+            Hole(
+                id=f"{view.target_id}{VIEW_SEPARATOR}{k}",
+                position=p_part.tolist(),
+                normal=(n_part / np.linalg.norm(n_part)).tolist(),
+                diameter=target.diameter,
             )
+        )
     part = cell.part.model_copy(update={"holes": holes})
     return cell.model_copy(update={"name": f"{cell.name}:reference", "part": part})
 
 
-class _LeftOutViews(logging.Filter):
-    """Holds back the planner's warnings about left-out holes while a reference tour is planned:
-    views the arm cannot take are expected there (the tour lists them in ``left_out``)."""
+class _DesignedViewsPlanner(TourPlanner):
+    """The tour planner with each pseudo-hole's only candidate the designed joint vector."""
 
-    def filter(self, record: logging.LogRecord) -> bool:
-        return "left out" not in record.getMessage()
+    def __init__(self, options: Options, design: Design) -> None:
+        super().__init__(options)
+        self.design = design
+
+    def _viewpoints(
+        self, arm: ArmLike, cell: CellLike
+    ) -> tuple[list[HoleCandidates], list[LeftOut]]:
+        found = []
+        for hole, view in zip(cell.holes_in_cell(), self.design.views, strict=True):
+            q = np.asarray(view.q_rad, float).reshape(1, 6)
+            found.append(
+                HoleCandidates(hole.id, q, np.zeros(1, np.int64), np.zeros(1, np.int64),
+                               arm.fk(q[0], "tcp")[None], None)
+            )  # fmt: skip
+        return found, []
 
 
 def plan_reference_tour(
-    cell: CellConfig, options: Options | None = None, views: ViewOptions | None = None
+    cell: CellConfig,
+    options: Options | None = None,
+    tour: Tour | None = None,
+    design: Design | None = None,
 ) -> Tour:
-    """Plan the tour home -> every reachable view of every reference target -> home. Views
-    left out (unreachable, in collision) are logged at INFO, not as warnings: the other views
-    of the target serve."""
-    planner_log, quiet = logging.getLogger(PLANNER_LOGGER), _LeftOutViews()
-    planner_log.addFilter(quiet)
-    try:
-        tour = plan_tour(reference_cell(cell, views), options or Options())
-    finally:
-        planner_log.removeFilter(quiet)
-    for h in tour.left_out:
-        log.info("reference view %s left out: %s", h.hole_id, h.reason)
-    return tour
+    """Plan the tour home -> every designed reference view -> home. The views are ``design``,
+    else :func:`design_reference_plan` for the stops of ``tour`` (else the holes')."""
+    if design is None:
+        stops = None if tour is None else np.array([s.q for s in tour.stops], float)
+        design = design_reference_plan(cell, stops)
+    for tid, reason in design.skipped.items():
+        log.info("reference target %s has no view: %s", tid, reason)
+    return _DesignedViewsPlanner(options or Options(), design).plan(reference_cell(cell, design))

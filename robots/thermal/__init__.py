@@ -9,6 +9,8 @@
 - :mod:`~robots.thermal.drift`: the drift generator (hidden truth for simulation and tests).
 - :mod:`~robots.thermal.observations`: observation sets, cell geometry, simulated observations.
 - :mod:`~robots.thermal.plan`: viewing poses of the reference targets (the pose plan).
+- :mod:`~robots.thermal.uncertainty`: the prediction covariance at a pose
+  (``ThermalModel.predict_covariance(q, temps_degC, point_tcp_m=None) -> (..., 3, 3) m^2``).
 - :mod:`~robots.thermal.csvio`, :mod:`~robots.thermal.modelfile`: CSV formats, thermal.json.
 """
 
@@ -46,6 +48,7 @@ from robots.thermal.identify import (
 from robots.thermal.model import ThermalModel, ThermalSpec
 from robots.thermal.observations import CellGeometry, Observations, simulate_observations
 from robots.thermal.plan import ViewOptions, ViewPlan, view_plan, view_pose
+from robots.thermal.uncertainty import prediction_covariance, term_jacobian
 
 __all__ = [
     "MATERIAL_EXPANSION_PER_K",
@@ -75,9 +78,11 @@ __all__ = [
     "default_settings",
     "identify",
     "plan_report",
+    "prediction_covariance",
     "reference_from_cold",
     "simulate_observations",
     "solve_tcp",
+    "term_jacobian",
     "view_plan",
     "view_pose",
 ]

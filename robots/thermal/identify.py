@@ -10,6 +10,12 @@ every candidate term is examined: terms without an effect, and terms that the
 data cannot separate from others (smallest singular value of the
 column-normalised Jacobian too small), are refused with a reason.
 
+Uncertainty: ``sigma^2 (J^T J)^-1`` with ``sigma`` from the residual, multiplied by the AR(1)
+variance factor ``(1 + rho) / (1 - rho)`` when the residuals of each pose group are serially
+correlated in time (lag-1 correlation ``rho`` above the white-noise level ``2 / sqrt(pairs)``):
+then the model's structure misses something (a link lagging its sensor, say), the rows are not
+independent measurements, and the plain covariance would be too optimistic.
+
 Units: terms ``k_link*`` in 1/K, ``c_joint*`` in rad/K; internally scaled by
 1e-6 (ppm/K, urad/K) so the solver works on numbers near one.
 """
@@ -159,6 +165,30 @@ class _Problem:
         return np.column_stack(cols) if cols else np.zeros((3 * len(self.q), 0))
 
 
+def serial_correlation(residual: Array, groups: Array, time_s: Array) -> tuple[float, int]:
+    """Pooled lag-1 correlation of the fit residuals (N, 3) within each pose group in time
+    order, and the number of consecutive pairs it rests on (per axis)."""
+    num = den = 0.0
+    pairs = 0
+    for g in np.unique(groups):
+        idx = np.flatnonzero(groups == g)
+        r = residual[idx[np.argsort(time_s[idx], kind="stable")]]
+        num += float(np.sum(r[1:] * r[:-1]))
+        den += float(np.sum(r**2))
+        pairs += 3 * (len(idx) - 1)
+    return (num / den if den > 0 else 0.0), pairs
+
+
+def inflation_factor(rho: float, pairs: int) -> float:
+    """The covariance factor for serially correlated residuals: ``(1 + rho) / (1 - rho)`` (the
+    AR(1) variance factor; ``rho`` capped at 0.95) when ``rho`` exceeds ``2 / sqrt(pairs)``
+    (white noise stays below it 97.5 % of the time), else 1."""
+    if pairs < 1 or rho <= 2.0 / np.sqrt(pairs):
+        return 1.0
+    rho = min(rho, 0.95)
+    return (1.0 + rho) / (1.0 - rho)
+
+
 def _no_effect_reason(name: str, table: DHTable, spec: ThermalSpec, problem: _Problem) -> str:
     kind, link = term_kind_and_link(name)
     a, d, _, _ = table.arrays()
@@ -277,7 +307,9 @@ def identify(
     r = sol.fun
     sigma = float(np.sqrt(r @ r / dof))
     J = problem.jacobian(terms, sol.x)
-    cov = sigma**2 * np.linalg.pinv(J.T @ J)
+    rho, pairs = serial_correlation(r.reshape(-1, 3), problem.groups, obs.time_s)
+    inflation = inflation_factor(rho, pairs)
+    cov = inflation * sigma**2 * np.linalg.pinv(J.T @ J)
     scale = np.array([TERM_SCALE[term_kind_and_link(n)[0]] for n in terms])
     values = {n: float(v) for n, v in zip(terms, sol.x * scale, strict=True)}
     std = {n: float(v) for n, v in zip(terms, np.sqrt(np.diag(cov)) * scale, strict=True)}
@@ -292,10 +324,13 @@ def identify(
         robot_model=robot_model,
         T_cell_base=np.asarray(geometry.T_cell_base, float),
         T_tool0_tcp=np.asarray(geometry.T_tool0_tcp, float),
+        covariance=cov * np.outer(scale, scale),
         fit={
             "residual_rms_m": rms,
             "residual_rms_before_m": float(np.sqrt(np.mean(r0**2))),
             "sigma_m": sigma,
+            "residual_lag1_correlation": rho,
+            "covariance_inflation": inflation,
             "rank": float(report.rank),
             "condition": report.condition_kept,
             "n_rows": float(len(obs)),

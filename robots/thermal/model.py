@@ -180,6 +180,8 @@ class ThermalModel:
         T_cell_base: robot base pose in the cell frame at identification (4x4).
         T_tool0_tcp: tool (TCP) pose relative to tool0 at identification (4x4).
         fit: summary figures of the identification (residual RMS in m, rank, condition, counts).
+        covariance: covariance of the identified terms (n x n, SI units squared) in the order of
+            ``coefficients``; None: only ``std`` is known (the diagonal).
     """
 
     table: DHTable
@@ -191,6 +193,7 @@ class ThermalModel:
     T_cell_base: Array = field(default_factory=lambda: np.eye(4))
     T_tool0_tcp: Array = field(default_factory=lambda: np.eye(4))
     fit: Mapping[str, float] = field(default_factory=dict)
+    covariance: Array | None = None
 
     def vectors(self) -> tuple[Array, Array]:
         """``(k (6,) 1/K, c (6,) rad/K)``."""
@@ -213,3 +216,19 @@ class ThermalModel:
         """Compensated ``T_base_tool0`` at joints ``q`` (..., 6) and readings (..., n_sensors)."""
         a, d, alpha, theta = self.arrays_at(temps_degC)
         return fk_rows(a, d, alpha, theta, q)
+
+    def predict_covariance(
+        self,
+        q: ArrayLike,
+        temps_degC: ArrayLike,
+        point_tcp_m: ArrayLike | None = None,
+        T_cell_base: ArrayLike | None = None,
+    ) -> Array:
+        """Covariance (..., 3, 3) in m^2, cell frame, of the compensated position of a TCP-fixed
+        point (default the TCP origin; ``point_tcp_m`` in the TCP frame, m) at joints ``q``
+        (..., 6) rad and sensor readings ``temps_degC`` (..., n_sensors) degC, propagated from
+        the terms' covariance (:func:`robots.thermal.uncertainty.prediction_covariance`).
+        ``T_cell_base`` defaults to the model's own base pose."""
+        from robots.thermal.uncertainty import prediction_covariance
+
+        return prediction_covariance(self, q, temps_degC, point_tcp_m, T_cell_base)

@@ -9,7 +9,13 @@ Layout (SI units; temperatures in degC)::
      "coefficients": {"k_link2": {"value": 2.3e-05, "std": 4e-07, "unit": "1/K"}, ...},
      "refused": {"k_link5": "link 5 has no D-H length (a5 = d5 = 0)"},
      "T_cell_base": {"xyz": [...], "quat_xyzw": [...]}, "T_tool0_tcp": {...},
-     "fit": {"residual_rms_m": ..., "rank": ..., "condition": ..., ...}}
+     "fit": {"residual_rms_m": ..., "rank": ..., "condition": ..., ...},
+     "covariance": {"terms": ["k_link1", ...], "matrix": [[...], ...]}}
+
+``covariance`` (optional; files written before it existed have only each term's ``std``) is the
+full covariance of the identified terms in SI units squared ((1/K)^2, (rad/K)^2), rows and columns
+in the order of ``terms``; :meth:`robots.thermal.ThermalModel.predict_covariance` propagates it
+to a TCP position covariance.
 """
 
 from __future__ import annotations
@@ -65,6 +71,16 @@ def model_to_dict(model: ThermalModel) -> dict[str, Any]:
         "T_cell_base": pose(model.T_cell_base),
         "T_tool0_tcp": pose(model.T_tool0_tcp),
         "fit": {k: float(v) for k, v in model.fit.items()},
+        **(
+            {}
+            if model.covariance is None
+            else {
+                "covariance": {
+                    "terms": list(model.coefficients),
+                    "matrix": np.asarray(model.covariance, float).tolist(),
+                }
+            }
+        ),
     }
 
 
@@ -102,6 +118,41 @@ def _pose(doc: dict[str, Any], path: str, src: str) -> np.ndarray:
     return pose_to_matrix(
         _vector(doc, f"{path}.xyz", src, 3), quat_xyzw=_vector(doc, f"{path}.quat_xyzw", src, 4)
     )
+
+
+def _covariance(doc: dict[str, Any], names: tuple[str, ...], src: str) -> np.ndarray | None:
+    """The optional covariance block, reordered to ``names`` (the coefficients' order)."""
+    if doc.get("covariance") is None:
+        return None
+    terms = [str(t) for t in _get(doc, "covariance.terms", src)]
+    if sorted(terms) != sorted(names) or len(set(terms)) != len(terms):
+        raise ThermalModelFileError(
+            src, "covariance.terms", f"{terms} do not match the coefficients {list(names)}"
+        )
+    rows = _get(doc, "covariance.matrix", src)
+    n = len(terms)
+    if not isinstance(rows, list) or len(rows) != n:
+        raise ThermalModelFileError(src, "covariance.matrix", f"expected {n} rows of {n} numbers")
+    M = np.array([_row(r, i, n, src) for i, r in enumerate(rows)]).reshape(n, n)
+    scale = np.sqrt(np.abs(np.outer(np.diag(M), np.diag(M)))) + 1e-300
+    if np.any(np.diag(M) < 0) or np.max(np.abs(M - M.T) / scale) > 1e-6:
+        raise ThermalModelFileError(
+            src, "covariance.matrix", "must be symmetric with a non-negative diagonal"
+        )
+    order = [terms.index(nm) for nm in names]
+    return M[np.ix_(order, order)]
+
+
+def _row(row: Any, i: int, n: int, src: str) -> list[float]:
+    try:
+        out = [float(v) for v in row]
+    except (TypeError, ValueError):
+        out = []
+    if len(out) != n or not all(math.isfinite(v) for v in out):
+        raise ThermalModelFileError(
+            src, f"covariance.matrix[{i}]", f"expected {n} finite numbers, got {row!r}"
+        )
+    return out
 
 
 def model_from_dict(doc: Any, src: str = "thermal.json") -> ThermalModel:
@@ -142,6 +193,7 @@ def model_from_dict(doc: Any, src: str = "thermal.json") -> ThermalModel:
         T_cell_base=_pose(doc, "T_cell_base", src),
         T_tool0_tcp=_pose(doc, "T_tool0_tcp", src),
         fit={str(k): float(v) for k, v in dict(doc.get("fit", {})).items() if v is not None},
+        covariance=_covariance(doc, tuple(coefficients), src),
     )
 
 

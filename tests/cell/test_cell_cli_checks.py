@@ -1,16 +1,17 @@
 """Command-line mistakes are refused at once with a clear message, before anything is planned,
-connected or written; the reference tour's left-out views are not warnings."""
+connected or written; the reference tour visits the designed views."""
 
 from __future__ import annotations
 
 import logging
 from pathlib import Path
 
+import numpy as np
 import pytest
 from cell_fixtures import SmallCell
 
 from cell.cli import main
-from cell.run.reference import plan_reference_tour
+from cell.run.reference import design_reference_plan, plan_reference_tour, target_of
 from planner import Options
 
 
@@ -57,13 +58,18 @@ def test_sim_refuses_an_unknown_missing_hole(small_cell: SmallCell, capsys) -> N
     assert code == 2 and "NOPE" in err and "--missing" in err and "Traceback" not in err
 
 
-def test_reference_views_left_out_are_info(small_cell: SmallCell, caplog) -> None:
+def test_reference_tour_visits_the_designed_views(small_cell: SmallCell, caplog) -> None:
+    """The runner's reference tour is the designed plan: every designed view, at exactly its
+    joint vector, nothing left out, no warning."""
+    design = design_reference_plan(small_cell.cell, np.array([s.q for s in small_cell.tour.stops]))
     with caplog.at_level(logging.INFO):
-        tour = plan_reference_tour(small_cell.cell, Options(seed=1))
-    assert tour.left_out, "the small cell's reference tour leaves a view out"
+        tour = plan_reference_tour(small_cell.cell, Options(seed=1), tour=small_cell.tour)
+    assert not tour.left_out and len(tour.stops) == len(design.views)
+    for s in tour.stops:
+        view = design.views[int(s.hole_id.split("#")[1])]
+        assert target_of(s.hole_id) == view.target_id
+        assert np.allclose(s.q, view.q_rad, atol=1e-12)
     assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
-    left = [r for r in caplog.records if "left out" in r.getMessage()]
-    assert left and all(r.levelno == logging.INFO for r in left)
 
 
 def test_run_default_reference_rounds_can_identify() -> None:
