@@ -61,11 +61,20 @@ def format_demo(res: DemoResult) -> str:
         ("holes measured", f"{bar(measured, planned, 20)} {measured}/{planned}"),
         ("missing / unmeasurable", f"{s['holes_missing']} / {s['holes_unmeasured']}"),
         ("out of tol. / suspect", f"{s['holes_failed']} / {s['holes_suspect']}"),
+        ("decisions (ISO 14253-1)" if s.get("decision_rule") != "simple" else "decisions (simple)",
+         f"{s['holes_conforming']} conformance proven / {s['holes_inconclusive']} inconclusive "
+         f"/ {s['holes_nonconforming']} nonconformance proven"),
+        ("largest U (k=2)", f"position {s['max_U_position_m'] * 1e6:.1f} um, diameter "
+                            f"{s['max_U_diameter_m'] * 1e6:.1f} um" if s["max_U_position_m"]
+                            else "-"),
+        ("part temperature", _part(s.get("part"))),
         ("worst deviation", f"{worst * 1e3:.4f} mm (hole {s['worst_hole']})" if worst else "-"),
         ("cycle time (planned)", f"{res.tour.cycle_time_s:.1f} s"),
         ("error vs truth, RMS", f"{tr.rms_m * 1e6:.1f} um (max {tr.max_m * 1e6:.1f} um)"),
         ("  without thermal comp.", f"{tr.rms_uncompensated_m * 1e6:.1f} um RMS"),
         ("diameter error, RMS", f"{tr.diameter_rms_m * 1e6:.1f} um"),
+        ("truth within U (k=2)", f"{tr.n_covered}/{tr.n_characteristics} "
+                                 f"({100 * tr.coverage:.1f} %) of positions and diameters"),
         ("thermal update", res.run.thermal or "-"),
         ("link", f"{res.run.link.get('requests', 0)} requests, "
                  f"{res.run.link.get('retransmits', 0)} retransmitted"),
@@ -74,6 +83,15 @@ def format_demo(res: DemoResult) -> str:
     ]  # fmt: skip
     width = max(len(k) for k, _ in rows)
     return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
+
+
+def _part(part: dict | None) -> str:
+    if not part:
+        return "-"
+    return (
+        f"{part['temperature_c']:.2f} degC +- {part['u_temperature_K']:.2f} K "
+        f"({part['source']}); results at 20 degC"
+    )
 
 
 def run_demo_cmd(args: argparse.Namespace) -> int:
