@@ -118,6 +118,14 @@ def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]])
     return f'<table id="holes">{head}{"".join(rows)}</table>'
 
 
+def _in_plane(r: HoleResult) -> np.ndarray:
+    """The centre's deviation without its axial part (part frame, m)."""
+    delta = np.subtract(r.center_part_m, r.nominal_part_m)
+    if r.axial_deviation_m is None or r.normal_part is None:
+        return delta
+    return delta - r.axial_deviation_m * np.asarray(r.normal_part, float)
+
+
 def _vector_plot(results: list[HoleResult]) -> str:
     """Deviation vectors over the part: side view (part x, z), arrows magnified."""
     m = [r for r in results if r.measured]
@@ -125,9 +133,7 @@ def _vector_plot(results: list[HoleResult]) -> str:
     if not m:
         return svg(W, 60, [text(10, 30, "no measured hole")], "deviation vectors")
     nom = np.array([r.nominal_part_m for r in m]) * 1e3
-    delta = np.array([r.center_part_m for r in m]) - np.array([r.nominal_part_m for r in m])
-    axial = np.array([r.axial_deviation_m or 0.0 for r in m])[:, None]
-    dev = (delta - axial * np.array([r.normal_part for r in m])) * 1e6  # in-plane
+    dev = np.array([_in_plane(r) for r in m]) * 1e6
     pad = 40.0
     ax = Axes(W, H, (nom[:, 0].min() - pad, nom[:, 0].max() + pad),
               (nom[:, 2].min() - pad, nom[:, 2].max() + pad))  # fmt: skip
