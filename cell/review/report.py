@@ -128,7 +128,8 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
         rows = [_row(r) for r in results]
         events = store.events()
         info, planned = {**store.run_info(), "run_dir": str(run_dir)}, store.planned()
-    html = render_html(summ, info, results, planned, operator)
+        reference = [(o[0], o[3]) for o in store.reference_observations()]
+    html = render_html(summ, info, results, planned, operator, reference)
     _atomic_write(run_dir / "report.html", html)
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events}  # fmt: skip

@@ -181,18 +181,29 @@ def _bar_plot(results: list[HoleResult], key: str, ukey: str, label: str) -> str
     return svg(W, H, body, f"{label} against the tolerance, with U (k = 2)")
 
 
-def _thermal_plot(results: list[HoleResult]) -> str:
-    """Sensor readings and the thermal compensation applied, over the run's controller time."""
+def _thermal_plot(results: list[HoleResult], reference: list[tuple[float, Any]]) -> str:
+    """Sensor readings over the run's controller time (reference rounds and holes), the
+    inspection window shaded, and the thermal compensation applied."""
     m = [r for r in results if r.temperatures_c]
     W, H = 900, 300
-    if not m:
+    if not m and not reference:
         return svg(W, 60, [text(10, 30, "no temperatures recorded")], "thermal drift")
-    t = np.array([r.sim_time_s for r in m]) / 60.0
-    temps = np.array([r.temperatures_c for r in m], float)
+    rows = sorted([(float(t), np.asarray(T, float)) for t, T in reference]
+                  + [(r.sim_time_s, np.asarray(r.temperatures_c, float)) for r in m],
+                  key=lambda x: x[0])  # fmt: skip
+    t = np.array([a for a, _ in rows]) / 60.0
+    temps = np.array([b for _, b in rows])
     ax = Axes(W, H, (t.min(), t.max() if t.max() > t.min() else t.min() + 1),
               (temps.min() - 0.5, temps.max() + 0.5), margin=(60, 220, 20, 40))  # fmt: skip
     body = frame(ax, "controller time (min)", "sensor reading (degC)", ticks(*ax.xlim),
                  ticks(*ax.ylim))  # fmt: skip
+    if m:
+        t0, t1 = min(r.sim_time_s for r in m) / 60.0, max(r.sim_time_s for r in m) / 60.0
+        body.append(
+            f'<rect x="{ax.x(t0):.1f}" y="{ax.top}" width="{max(ax.x(t1) - ax.x(t0), 2):.1f}" '
+            f'height="{ax.h - ax.top - ax.bottom}" fill="#1565c0" opacity="0.08"/>'
+        )
+        body.append(text(ax.x(t0) - 4, ax.top + 12, "holes", 10, "end", fill="#1565c0"))
     for j in range(temps.shape[1]):
         pts = " ".join(f"{ax.x(a):.1f},{ax.y(b):.1f}" for a, b in zip(t, temps[:, j], strict=True))
         c = SERIES[j % len(SERIES)]
@@ -234,8 +245,10 @@ def _budget_table(results: list[HoleResult]) -> str:
 
 
 def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleResult],
-                planned: list[tuple[str, int, dict]], operator: str = "") -> str:  # fmt: skip
-    """The whole ``report.html`` document."""
+                planned: list[tuple[str, int, dict]], operator: str = "",
+                reference: list[tuple[float, Any]] | None = None) -> str:  # fmt: skip
+    """The whole ``report.html`` document; ``reference``: (controller time s, readings degC)
+    of the reference-target observations, for the thermal plot."""
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>Inspection report {escape(summ['cell'])}</title><style>{CSS}</style></head><body>",
@@ -251,7 +264,7 @@ def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleRe
         _bar_plot(results, "position_deviation_m", "U_position_m", "position deviation"),
         "<h2>Diameter deviation against the tolerance</h2>",
         _bar_plot(results, "diameter_deviation_m", "U_diameter_m", "|diameter deviation|"),
-        "<h2>Thermal drift over the run</h2>", _thermal_plot(results),
+        "<h2>Thermal drift over the run</h2>", _thermal_plot(results, reference or []),
         "<h2>Uncertainty budget (standard uncertainties, GUM)</h2>", _budget_table(results),
         f"<p class='note'>written {_date(time.time())} by holecell</p></body></html>",
     ]  # fmt: skip

@@ -57,6 +57,7 @@ class DemoOptions:
             calibration by a draw from the calibration's uncertainty, the part's expansion
             coefficient by a draw from its material's (False: a perfect arm and head).
         decision_rule: the run's decision rule.
+        operator: the report's operator field.
     """
 
     warmup_speed: float = 1500.0
@@ -70,6 +71,7 @@ class DemoOptions:
     u_part_temperature_K: float = 0.2  # noqa: N815 (unit suffix)
     realistic: bool = True
     decision_rule: str = DEFAULT_RULE
+    operator: str = ""
 
 
 @dataclass
@@ -88,6 +90,8 @@ class TruthError:
     n_characteristics: int = 0
     position_covered: list[bool] = field(default_factory=list)
     diameter_covered: list[bool] = field(default_factory=list)
+    rms_in_plane_m: float = float("nan")
+    max_in_plane_m: float = float("nan")
 
 
 @dataclass
@@ -108,7 +112,7 @@ def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
     deviation (in the plane of the nominal axis) and ``|D - D_true| <= U_diameter``."""
     T_part_cell = invert(world.cell.T_cell_part())
     normals = {h.id: np.asarray(h.normal, float) for h in world.cell.part.holes}
-    e, e_u, e_d, cov_p, cov_d = [], [], [], [], []
+    e, e_u, e_d, e_p, cov_p, cov_d = [], [], [], [], [], []
     for r in results:
         if r.center_part_m is None:
             continue
@@ -117,6 +121,9 @@ def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
         e.append(np.linalg.norm(np.array(r.center_part_m) - true_c))
         e_u.append(np.linalg.norm(np.array(r.extra["center_part_uncompensated_m"]) - true_c))
         e_d.append(r.diameter_m - h.diameter_m)
+        n = normals[r.hole_id]
+        err = np.array(r.center_part_m) - true_c
+        e_p.append(np.linalg.norm(err - (err @ n) * n))
         if r.U_position_m is not None:
             nom = np.array(r.nominal_part_m)
             d_true = deviations(true_c, h.diameter_m, nom, r.nominal_diameter_m, None,
@@ -130,7 +137,8 @@ def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
     covered = cov_p + cov_d
     cov = float(np.mean(covered)) if covered else float("nan")
     return TruthError(rms(e), float(max(e, default=float("nan"))), rms(e_u), rms(e_d), len(e),
-                      cov, int(np.sum(covered)), len(covered), cov_p, cov_d)  # fmt: skip
+                      cov, int(np.sum(covered)), len(covered), cov_p, cov_d, rms(e_p),
+                      float(max(e_p, default=float("nan"))))  # fmt: skip
 
 
 def _plan_reference(seed: int) -> dict[str, Any]:
@@ -179,7 +187,7 @@ def run_demo(
             files.store.close()
             if recorder is not None:
                 recorder.close()
-    summary = write_report(out_dir)
+    summary = write_report(out_dir, opts.operator)
     timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
                "total_s": time.perf_counter() - t0}  # fmt: skip
     return DemoResult(Path(out_dir), tour, result, summary, truth, timings)
