@@ -19,6 +19,13 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator
 
 from cell.errors import ConfigError
+from cell.uncertainty.materials import (
+    ALPHA_MAX_PER_K,
+    ALPHA_MIN_PER_K,
+    BUILTIN_MATERIALS,
+    DEFAULT_MATERIAL,
+    Material,
+)
 from robots import DEFAULT_MODEL, Arm, LimitScaling, LimitsError, RobotModelError, Shape
 from robots.transforms import pose_to_matrix
 
@@ -133,6 +140,8 @@ class Robot(_Strict):
     limits: Limits = Limits()
     #: folders (relative to the cell file) searched first for package:// mesh URIs
     package_paths: list[str] = []
+    #: ISO 9283 pose repeatability RP (m); None: the maker's figure for the model
+    repeatability_m: Annotated[float, Field(gt=0, le=1e-3)] | None = None
 
 
 class Tool(_Strict):
@@ -152,10 +161,45 @@ class Hole(_Strict):
     _unit_normal = field_validator("normal")(lambda cls, v: _unit(v))
 
 
+#: plausible part temperatures (degC): outside, the figure is a mistake (kelvin, a typo)
+PART_TEMPERATURE_RANGE_C = (-10.0, 50.0)
+
+
+class MaterialSpec(_Strict):
+    """The part's material: expansion coefficient (1/K) and its standard uncertainty."""
+
+    name: Annotated[str, Field(min_length=1)]
+    alpha_per_K: Annotated[float, Field(ge=ALPHA_MIN_PER_K, le=ALPHA_MAX_PER_K)]  # noqa: N815
+    u_alpha_per_K: Annotated[float, Field(ge=0, le=1e-4)]  # noqa: N815
+
+
+def _material(value: Any) -> Any:
+    """A built-in material name becomes its figures; a mapping is validated as given."""
+    if isinstance(value, str):
+        if value not in BUILTIN_MATERIALS:
+            known = ", ".join(sorted(BUILTIN_MATERIALS))
+            raise ValueError(f"unknown material (built-in: {known}; or give name, alpha_per_K "
+                             "and u_alpha_per_K)")  # fmt: skip
+        m = BUILTIN_MATERIALS[value]
+        return {"name": m.name, "alpha_per_K": m.alpha_per_K, "u_alpha_per_K": m.u_alpha_per_K}
+    return value
+
+
 class Part(_Strict):
     base: Pose = IDENTITY
     holes: list[Hole] = []
     obstacles: list[ShapeSpec] = []
+    #: a built-in name or {name, alpha_per_K, u_alpha_per_K}; None: steel assumed
+    material: MaterialSpec | None = None
+    #: the part's temperature when a run is given no reading (degC; a conditioned room)
+    temperature_c: (
+        Annotated[float, Field(ge=PART_TEMPERATURE_RANGE_C[0], le=PART_TEMPERATURE_RANGE_C[1])]
+        | None
+    ) = None
+    #: standard uncertainty of ``temperature_c`` (K)
+    u_temperature_K: Annotated[float, Field(gt=0, le=10)] | None = None  # noqa: N815
+
+    _material = field_validator("material", mode="before")(lambda cls, v: _material(v))
 
 
 class Environment(_Strict):
@@ -280,6 +324,13 @@ class CellConfig(_Strict):
         arm.add_obstacles(self.obstacle_shapes())
         return arm
 
+    def part_material(self) -> tuple[Material, bool]:
+        """The part's material and whether the cell file named it (False: steel assumed)."""
+        m = self.part.material
+        if m is None:
+            return BUILTIN_MATERIALS[DEFAULT_MATERIAL], False
+        return Material(m.name, m.alpha_per_K, m.u_alpha_per_K), True
+
     def calibration_path(self) -> Path | None:
         """The stereo calibration file, resolved against the cell file's folder."""
         if self.tool.calibration is None:
@@ -326,6 +377,13 @@ def _duplicate_ids(cfg: CellConfig) -> list[tuple[str, object, str]]:
     return problems
 
 
+def _part_temperature_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
+    if cfg.part.u_temperature_K is not None and cfg.part.temperature_c is None:
+        msg = "needs part.temperature_c (the temperature it is the uncertainty of)"
+        return [("part.u_temperature_K", cfg.part.u_temperature_K, msg)]
+    return []
+
+
 def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
     try:
         arm = cfg.build_arm()
@@ -365,7 +423,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
         raise ConfigError(source, _pydantic_problems(exc)) from exc
     cfg._source_path = source_path
     cfg._raw_text = text
-    problems = _duplicate_ids(cfg) or _robot_problems(cfg)
+    problems = _duplicate_ids(cfg) + _part_temperature_problems(cfg) or _robot_problems(cfg)
     if problems:
         raise ConfigError(source, problems)
     return cfg

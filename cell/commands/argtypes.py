@@ -44,6 +44,26 @@ def positive_float(text: str) -> float:
     return value
 
 
+def part_temperature_c(text: str) -> float:
+    """A part temperature in degC within the plausible range (ISO 1 correction input)."""
+    from cell.uncertainty.part_temperature import RANGE_C
+
+    value = _finite(text)
+    if not RANGE_C[0] <= value <= RANGE_C[1]:
+        raise argparse.ArgumentTypeError(
+            f"{value} degC is outside [{RANGE_C[0]:g}, {RANGE_C[1]:g}] degC (kelvin or Fahrenheit?)"
+        )
+    return value
+
+
+def temperature_u_K(text: str) -> float:
+    """A temperature's standard uncertainty in K, in (0, 10]."""
+    value = positive_float(text)
+    if value > 10.0:
+        raise argparse.ArgumentTypeError(f"{value} K is more than 10 K")
+    return value
+
+
 def probability(text: str) -> float:
     """A number in [0, 1]."""
     value = _finite(text)

@@ -6,8 +6,10 @@ import argparse
 import time
 from pathlib import Path
 
+from cell.commands.argtypes import part_temperature_c
 from cell.commands.run_progress import RunBars, bar
 from cell.run.demo import DemoOptions, DemoResult, run_demo
+from cell.uncertainty.decision import DECISION_RULES, DEFAULT_RULE
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -19,13 +21,36 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Plans the tour of the built-in motorcycle frame, runs it on the simulated "
             "controller over a pseudo-terminal with a warming arm (reference targets measured "
             "during the warm-up, thermal model identified), measures every hole with the "
-            "simulated stereo head, and writes DIR/results.sqlite, report.json, report.csv "
-            "and run.rrd. Prints a summary with the measurement error against the simulation's "
-            "truth."
+            "simulated stereo head, and writes DIR/results.sqlite, report.json, report.csv, "
+            "run.rrd and report.html (the inspection protocol). The simulated cell has the "
+            "errors a real one has (arm repeatability, calibration, part temperature; "
+            "--ideal: none). Prints a summary with the measurement error against the "
+            "simulation's truth and how often the truth lies within U."
         ),
     )
     p.add_argument("--out", default=None, help="run directory (default: out/demo-<time>)")
     p.add_argument("--seed", type=int, default=0, help="seed of the simulated part and noise")
+    p.add_argument(
+        "--decision",
+        choices=DECISION_RULES,
+        default=DEFAULT_RULE,
+        help="decision rule per hole (default iso14253: ISO 14253-1 with U)",
+    )
+    p.add_argument(
+        "--part-temperature",
+        type=part_temperature_c,
+        default=23.0,
+        metavar="C",
+        help="the simulated part's true temperature (default 23 degC; the run is "
+        "given a thermometer reading of it)",
+    )
+    p.add_argument(
+        "--ideal",
+        action="store_true",
+        help="a perfect simulated arm and head (no repeatability scatter, the head "
+        "exactly as calibrated): only image noise and thermal drift",
+    )
+    p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
     p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
@@ -61,11 +86,23 @@ def format_demo(res: DemoResult) -> str:
         ("holes measured", f"{bar(measured, planned, 20)} {measured}/{planned}"),
         ("missing / unmeasurable", f"{s['holes_missing']} / {s['holes_unmeasured']}"),
         ("out of tol. / suspect", f"{s['holes_failed']} / {s['holes_suspect']}"),
+        ("decisions (ISO 14253-1)" if s.get("decision_rule") != "simple" else "decisions (simple)",
+         f"{s['holes_conforming']} conformance proven / {s['holes_inconclusive']} inconclusive "
+         f"/ {s['holes_nonconforming']} nonconformance proven"),
+        ("largest U (k=2)", f"position {s['max_U_position_m'] * 1e6:.1f} um, diameter "
+                            f"{s['max_U_diameter_m'] * 1e6:.1f} um" if s["max_U_position_m"]
+                            else "-"),
+        ("part temperature", _part(s.get("part"))),
         ("worst deviation", f"{worst * 1e3:.4f} mm (hole {s['worst_hole']})" if worst else "-"),
         ("cycle time (planned)", f"{res.tour.cycle_time_s:.1f} s"),
-        ("error vs truth, RMS", f"{tr.rms_m * 1e6:.1f} um (max {tr.max_m * 1e6:.1f} um)"),
+        ("position error vs truth", f"{tr.rms_in_plane_m * 1e6:.1f} um RMS in the hole plane "
+                                    f"(max {tr.max_in_plane_m * 1e6:.1f} um)"),
+        ("centre error vs truth", f"{tr.rms_m * 1e6:.1f} um RMS in 3-D (max "
+                                  f"{tr.max_m * 1e6:.1f} um; along the axis: depth)"),
         ("  without thermal comp.", f"{tr.rms_uncompensated_m * 1e6:.1f} um RMS"),
         ("diameter error, RMS", f"{tr.diameter_rms_m * 1e6:.1f} um"),
+        ("truth within U (k=2)", f"{tr.n_covered}/{tr.n_characteristics} "
+                                 f"({100 * tr.coverage:.1f} %) of positions and diameters"),
         ("thermal update", res.run.thermal or "-"),
         ("link", f"{res.run.link.get('requests', 0)} requests, "
                  f"{res.run.link.get('retransmits', 0)} retransmitted"),
@@ -76,13 +113,28 @@ def format_demo(res: DemoResult) -> str:
     return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
 
 
+def _part(part: dict | None) -> str:
+    if not part:
+        return "-"
+    return (
+        f"{part['temperature_c']:.2f} degC +- {part['u_temperature_K']:.2f} K "
+        f"({part['source']}); results at 20 degC"
+    )
+
+
 def run_demo_cmd(args: argparse.Namespace) -> int:
     """Handler of ``holecell demo``."""
     out = Path(args.out) if args.out else Path("out") / time.strftime("demo-%Y%m%d-%H%M%S")
     bars = None if args.quiet else RunBars(0)
     res = run_demo(
         out,
-        DemoOptions(seed=args.seed),
+        DemoOptions(
+            seed=args.seed,
+            decision_rule=args.decision,
+            part_temperature_c=args.part_temperature,
+            realistic=not args.ideal,
+            operator=args.operator,
+        ),
         _plan_bars(args.quiet),
         _progress(bars),
         _recorder_factory(args),

@@ -15,16 +15,19 @@ def register(sub: argparse._SubParsersAction) -> None:
         description=(
             "Reads RUN_DIR/results.sqlite (never modifies it) and writes RUN_DIR/report.json "
             "(summary, every hole, every event; SI units) and RUN_DIR/report.csv (one row per "
-            "hole: nominal and measured centre, deviation, diameter, pass, uncertainty)."
+            "hole: nominal and measured centre, deviation, diameter, pass, uncertainty) and "
+            "RUN_DIR/report.html (the inspection protocol: header, hole table with U and the "
+            "ISO 14253-1 decision, plots; self-contained)."
         ),
     )
     p.add_argument("run_dir", help="a run directory (holds results.sqlite)")
+    p.add_argument("--operator", default="", help="name for the report's operator field")
     p.set_defaults(handler=run_report)
 
 
 def run_report(args: argparse.Namespace) -> int:
     """Handler of ``holecell report``."""
-    summ = write_report(args.run_dir)
+    summ = write_report(args.run_dir, args.operator)
     print(format_summary(summ))
-    print(f"wrote {args.run_dir}/report.json and {args.run_dir}/report.csv")
+    print(f"wrote {args.run_dir}/report.json, report.csv and report.html")
     return 0

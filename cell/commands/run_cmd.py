@@ -7,7 +7,12 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from cell.commands.argtypes import non_negative_float, non_negative_int
+from cell.commands.argtypes import (
+    non_negative_float,
+    non_negative_int,
+    part_temperature_c,
+    temperature_u_K,
+)
 from cell.commands.run_progress import RunBars
 from cell.config import CellConfig, load_cell
 from cell.errors import CellError
@@ -20,6 +25,7 @@ from cell.run.reference import plan_reference_tour
 from cell.run.runner import Runner, RunOptions
 from cell.run.setup import RunFiles, check_new_run_dir, check_tour, resume_run, start_run
 from cell.run.thermal_check import check_model_for_cell, check_model_sensors
+from cell.uncertainty.decision import DECISION_RULES, DEFAULT_RULE
 from planner import load_tour
 from robots.thermal.model import ThermalModel
 from robots.thermal.modelfile import load_model
@@ -40,7 +46,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "measures every hole. "
             "Writes RUN_DIR/results.sqlite (every hole in its own transaction), report.json "
             "and report.csv, and records the run to RUN_DIR/run.rrd (Rerun; --spawn or --connect "
-            "to watch it live). --resume RUN_DIR continues a stopped run from the first hole not "
+            "to watch it live), and report.html, the inspection protocol (U per hole, ISO 14253-1 "
+            "decision, plots). --resume RUN_DIR continues a stopped run from the first hole not "
             "stored, with the cell and tour stored in it."
         ),
     )
@@ -60,6 +67,26 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="controller seconds between reference rounds")  # fmt: skip
     p.add_argument("--settle-s", type=non_negative_float, default=0.2,
                    help="settling wait (s)")  # fmt: skip
+    p.add_argument("--part-temperature", type=part_temperature_c, metavar="C",
+                   help="the part's temperature (degC, read on the part): every position and "
+                        "diameter is reported at 20 degC (ISO 1). Without it: the cell file's "
+                        "part.temperature_c, else 20 degC assumed with 2.9 K uncertainty; a "
+                        "resumed run keeps the one it stored")  # fmt: skip
+    p.add_argument(
+        "--u-part-temperature",
+        type=temperature_u_K,
+        metavar="K",
+        help="standard uncertainty of --part-temperature (default 0.2 K)",
+    )
+    p.add_argument(
+        "--decision",
+        choices=DECISION_RULES,
+        default=DEFAULT_RULE,
+        help="decision rule per hole: iso14253 (ISO 14253-1: conformance or "
+        "nonconformance proven with the expanded uncertainty U, else "
+        "inconclusive; default) or simple (deviation against tolerance)",
+    )
+    p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
     p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
@@ -140,11 +167,11 @@ def _clear_fault(client: ControllerClient, args: argparse.Namespace) -> None:
     print(f"controller fault cleared ({what} before RESET)", file=sys.stderr)
 
 
-def _report_stopped_run(run_dir: Path) -> None:
+def _report_stopped_run(run_dir: Path, operator: str = "") -> None:
     """Write the report of a run that stopped early and print its summary on stderr (a store
     that cannot be read any more is said so, not raised over the reason the run stopped)."""
     try:
-        print(format_summary(write_report(run_dir)), file=sys.stderr)
+        print(format_summary(write_report(run_dir, operator)), file=sys.stderr)
     except (CellError, OSError) as exc:
         print(f"no report written: {exc}", file=sys.stderr)
 
@@ -176,6 +203,9 @@ def run_run(args: argparse.Namespace) -> int:
             settle_s=args.settle_s,
             reference_rounds=args.reference_rounds,
             reference_interval_s=args.reference_interval_s,
+            part_temperature_c=args.part_temperature,
+            u_part_temperature_K=args.u_part_temperature,
+            decision_rule=args.decision,
         )
         progress = None if args.quiet else RunBars(len(files.tour.stops), stored)
         if not args.no_record:
@@ -187,7 +217,7 @@ def run_run(args: argparse.Namespace) -> int:
             result = runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
         except BaseException:
             files.store.close()
-            _report_stopped_run(run_dir)
+            _report_stopped_run(run_dir, args.operator)
             raise
         if result.thermal:
             print(result.thermal)
@@ -199,6 +229,6 @@ def run_run(args: argparse.Namespace) -> int:
             recorder.close()
         if files is not None:
             files.store.close()
-    print(format_summary(write_report(run_dir)))
+    print(format_summary(write_report(run_dir, args.operator)))
     print(f"run directory: {run_dir}")
     return 0

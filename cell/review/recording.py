@@ -14,6 +14,10 @@ attached to the scene root by ``T_cell_base``):
   with its edge points (filled ones in orange) and fitted ellipse drawn over it.
 - ``plots/deviation/*`` (um), ``plots/temperature/*`` (degC): time series; ``run/state``: the
   run state as a state timeline.
+- ``plots/uncertainty/U_position|U_diameter`` (um, k = 2) and ``plots/budget/<component>`` (the
+  position's standard uncertainty per component, um): time series; ``run/decision``: the ISO
+  14253-1 decision of each hole as a log line; ``run/decisions/<hole>``: the hole coloured by
+  it (green proven, orange inconclusive, red nonconforming).
 
 An explicit default blueprint lays it out (3D view, the two cameras, plots, state timeline).
 """
@@ -53,6 +57,7 @@ def blueprint() -> rrb.Blueprint:
                     rrb.Spatial2DView(name="right camera", origin="/camera/right"),
                 ),
                 rrb.TimeSeriesView(name="deviation (um)", origin="/plots/deviation"),
+                rrb.TimeSeriesView(name="U, k=2 (um)", origin="/plots/uncertainty"),
                 rrb.TimeSeriesView(name="temperatures (degC)", origin="/plots/temperature"),
                 rrb.StateTimelineView(name="run state", origin="/run/state"),
             ),
@@ -196,6 +201,7 @@ class Recorder:
             return
         rec.log("plots/deviation/position", rr.Scalars(result.position_deviation_m * 1e6))
         rec.log("plots/deviation/diameter", rr.Scalars(result.diameter_deviation_m * 1e6))
+        self._budget(result)
         self._images(meas, pair)
         T = self.T_view_cell @ T_cell_left
         pts = meas.points_m[meas.inliers] @ T[:3, :3].T + T[:3, 3]
@@ -204,6 +210,33 @@ class Recorder:
             "run/hole/circle",
             rr.LineStrips3D([_circle(meas, T)], radii=0.0003, colors=[255, 0, 80]),
         )
+
+    def _budget(self, result: HoleResult) -> None:
+        """U (k = 2) and every component of the hole's budget as time series (um), the
+        decision as a log line, and the hole's nominal position coloured by it."""
+        if result.U_position_m is None:
+            return
+        rec = self.rec
+        rec.log("plots/uncertainty/U_position", rr.Scalars(result.U_position_m * 1e6))
+        rec.log("plots/uncertainty/U_diameter", rr.Scalars(result.U_diameter_m * 1e6))
+        for c in (result.budget or {}).get("components", []):
+            rec.log(f"plots/budget/{c['name']}", rr.Scalars(c["u_position_m"] * 1e6))
+        level = {"conforming": "INFO", "inconclusive": "WARN", "nonconforming": "ERROR"}
+        rec.log("run/decision", rr.TextLog(
+            f"{result.hole_id}: {result.decision or 'no tolerance'} (deviation "
+            f"{result.position_deviation_m * 1e6:.1f} um +- {result.U_position_m * 1e6:.1f} um, "
+            f"diameter {result.diameter_deviation_m * 1e6:+.1f} um +- "
+            f"{result.U_diameter_m * 1e6:.1f} um, k = 2)",
+            level=level.get(result.decision or "", "INFO")))  # fmt: skip
+        color = {
+            "conforming": [46, 125, 50],
+            "inconclusive": [239, 143, 0],
+            "nonconforming": [198, 40, 40],
+        }.get(result.decision or "", [117, 117, 117])
+        hole = {h.id: h for h in self.cell.holes_in_cell()}[result.hole_id]
+        rec.log(f"run/decisions/{result.hole_id}",
+                rr.Points3D(self._p(hole.position_m), radii=0.006, colors=[color],
+                            labels=[f"{result.hole_id} {result.decision or ''}"]))  # fmt: skip
 
     def _images(self, meas, pair) -> None:
         m = meas

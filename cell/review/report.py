@@ -3,10 +3,14 @@
 Files are in SI units (m); the printed summary is for people (mm, um). CSV columns:
 ``hole_id, stop, status, nominal_x_m .. nominal_z_m, measured_x_m .. measured_z_m,
 position_deviation_m, nominal_diameter_m, diameter_m, diameter_deviation_m, tolerance_m,
-pass, u_center_m, u_diameter_m, reason, thermal_model_id`` (empty cells where a hole was not
+pass, u_center_m, u_diameter_m, reason, thermal_model_id, axial_deviation_m, U_position_m,
+U_diameter_m, decision, decision_rule`` and one ``u_<component>_position_m`` /
+``u_<component>_diameter_m`` pair per budget component (empty cells where a hole was not
 measured; ``thermal_model_id``: the row of the store's ``thermal_models`` the hole was
 compensated with, empty for the nominal kinematics).
-``u_*`` are one-sigma uncertainties from the circle fit's covariance.
+``u_center_m`` / ``u_diameter_m`` are the circle fit's own one-sigma uncertainties (kept for
+compatibility); ``U_*`` the expanded (k = 2) uncertainties of the whole budget
+(:mod:`cell.uncertainty.budget`); positions and diameters are at 20 degC.
 """
 
 from __future__ import annotations
@@ -16,8 +20,11 @@ import json
 from pathlib import Path
 from typing import Any
 
+from cell.review.report_html import render_html
 from cell.review.store import Store
 from cell.run.results import HoleResult
+from cell.uncertainty.budget import COMPONENTS
+from cell.uncertainty.decision import CONFORMING, INCONCLUSIVE, NONCONFORMING
 
 CSV_COLUMNS = (
     "hole_id", "stop", "status",
@@ -25,6 +32,8 @@ CSV_COLUMNS = (
     "measured_x_m", "measured_y_m", "measured_z_m",
     "position_deviation_m", "nominal_diameter_m", "diameter_m", "diameter_deviation_m",
     "tolerance_m", "pass", "u_center_m", "u_diameter_m", "reason", "thermal_model_id",
+    "axial_deviation_m", "U_position_m", "U_diameter_m", "decision", "decision_rule",
+    *(f"u_{c}_{q}_m" for c in COMPONENTS for q in ("position", "diameter")),
 )  # fmt: skip
 
 
@@ -48,6 +57,17 @@ def summary(store: Store) -> dict[str, Any]:
         "holes_failed": sum(r.passed is False for r in results),
         "holes_suspect": sum(r.status == "suspect" for r in results),
         "holes_not_reached": len(planned) - len(results),
+        "holes_conforming": sum(r.decision == CONFORMING for r in results),
+        "holes_inconclusive": sum(r.decision == INCONCLUSIVE for r in results),
+        "holes_nonconforming": sum(r.decision == NONCONFORMING for r in results),
+        "decision_rule": next((r.decision_rule for r in results if r.decision_rule), None),
+        "part": store.part_state(),
+        "max_U_position_m": max(
+            (r.U_position_m for r in measured if r.U_position_m is not None), default=None
+        ),
+        "max_U_diameter_m": max(
+            (r.U_diameter_m for r in measured if r.U_diameter_m is not None), default=None
+        ),
         "worst_position_deviation_m": worst.position_deviation_m if worst else None,
         "worst_hole": worst.hole_id if worst else None,
         "worst_diameter_deviation_m": max(
@@ -77,16 +97,40 @@ def _row(r: HoleResult) -> dict[str, Any]:
         "u_diameter_m": r.u_diameter_m,
         "reason": r.reason,
         "thermal_model_id": r.thermal_model_id,
+        "axial_deviation_m": r.axial_deviation_m,
+        "U_position_m": r.U_position_m,
+        "U_diameter_m": r.U_diameter_m,
+        "decision": r.decision,
+        "decision_rule": r.decision_rule,
+        **_components(r),
     }  # fmt: skip
 
 
-def write_report(run_dir: str | Path) -> dict[str, Any]:
-    """Write ``report.json`` and ``report.csv`` into ``run_dir``; returns the summary."""
+def _components(r: HoleResult) -> dict[str, Any]:
+    """The budget's components as ``u_<name>_position_m`` / ``u_<name>_diameter_m`` columns."""
+    out: dict[str, Any] = {
+        f"u_{c}_{q}_m": None for c in COMPONENTS for q in ("position", "diameter")
+    }
+    for c in (r.budget or {}).get("components", []):
+        out[f"u_{c['name']}_position_m"] = c["u_position_m"]
+        out[f"u_{c['name']}_diameter_m"] = c["u_diameter_m"]
+    return out
+
+
+def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
+    """Write ``report.json``, ``report.csv`` and ``report.html`` (the inspection protocol,
+    :mod:`cell.review.report_html`; ``operator`` fills its operator field) into ``run_dir``;
+    returns the summary."""
     run_dir = Path(run_dir)
     with Store.open(run_dir) as store:
         summ = summary(store)
-        rows = [_row(r) for r in store.results()]
+        results = store.results()
+        rows = [_row(r) for r in results]
         events = store.events()
+        info, planned = {**store.run_info(), "run_dir": str(run_dir)}, store.planned()
+        reference = [(o[0], o[3]) for o in store.reference_observations()]
+    html = render_html(summ, info, results, planned, operator, reference)
+    _atomic_write(run_dir / "report.html", html)
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events}  # fmt: skip
     (run_dir / "report.json").write_text(json.dumps(doc, indent=1))
@@ -96,6 +140,12 @@ def write_report(run_dir: str | Path) -> dict[str, Any]:
         for row in rows:
             w.writerow({k: ("" if v is None else v) for k, v in row.items()})
     return summ
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
 
 
 def format_summary(summ: dict[str, Any]) -> str:
@@ -110,8 +160,20 @@ def format_summary(summ: dict[str, Any]) -> str:
         f"{summ['holes_failed']} out of tolerance, {summ['holes_suspect']} suspect, "
         f"{summ['holes_not_reached']} not reached "
         f"(of {summ['holes_planned']} planned)",
+        f"decisions       {summ['holes_conforming']} conformance proven, "
+        f"{summ['holes_inconclusive']} inconclusive, "
+        f"{summ['holes_nonconforming']} nonconformance proven "
+        f"(rule {summ['decision_rule'] or '-'})",
     ]
+    part = summ.get("part")
+    if part:
+        lines.append(f"part            {part['temperature_c']:.2f} degC "
+                     f"+- {part['u_temperature_K']:.2f} K ({part['source']}), {part['material']}; "
+                     "results at 20 degC")  # fmt: skip
     if worst is not None:
         lines.append(f"worst position  {worst * 1e3:.4f} mm (hole {summ['worst_hole']})")
         lines.append(f"worst diameter  {dia * 1e3:.4f} mm")
+    if summ.get("max_U_position_m") is not None:
+        lines.append(f"largest U (k=2) position {summ['max_U_position_m'] * 1e6:.1f} um, "
+                     f"diameter {summ['max_U_diameter_m'] * 1e6:.1f} um")  # fmt: skip
     return "\n".join(lines)

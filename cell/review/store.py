@@ -6,8 +6,11 @@ planned hole with its stop index and nominal geometry), ``measurements`` (at mos
 hole: a UNIQUE key makes storing a hole twice impossible), ``events`` (run state changes,
 faults, retries, thermal updates), ``reference_observations`` (every measured reference target:
 round, controller time, target, joints, readings, target in the TCP frame; one transaction each)
-and ``thermal_models`` (every thermal model the run used, as ``thermal.json`` text, with where
-it came from; a hole's result names the model it was compensated with, ``thermal_model_id``).
+``thermal_models`` (every thermal model the run used, as ``thermal.json`` text, with where
+it came from; a hole's result names the model it was compensated with, ``thermal_model_id``)
+and, since schema version 3, ``uncertainty`` (per measured hole, every component of its budget:
+standard uncertainties of the position deviation and the diameter, m, and the note); ``meta``
+keeps the part's temperature state (``part_state``).
 
 A new store is built completely in a temporary file next to it and then renamed into place, so
 a failed creation leaves no half-made ``results.sqlite`` behind. Each hole is stored in one
@@ -30,9 +33,9 @@ import numpy as np
 from cell.errors import CellError
 from cell.run.results import HoleResult
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 #: versions :meth:`Store.open` can read; older ones get the tables added since (nothing removed)
-READABLE_VERSIONS = ("1", "2")
+READABLE_VERSIONS = ("1", "2", "3")
 FILENAME = "results.sqlite"
 
 _SCHEMA = (
@@ -70,8 +73,15 @@ CREATE TABLE IF NOT EXISTS thermal_models (
     stored_at REAL NOT NULL
 );
 """
+    + """
+CREATE TABLE IF NOT EXISTS uncertainty (
+    hole_id TEXT NOT NULL REFERENCES measurements(hole_id) ON DELETE CASCADE,
+    component TEXT NOT NULL, u_position_m REAL NOT NULL, u_diameter_m REAL NOT NULL,
+    note TEXT NOT NULL, PRIMARY KEY (hole_id, component)
+);
+"""
 )
-#: the tables added by schema version 2
+#: the tables added by schema versions 2 and 3
 _SCHEMA_V2 = _SCHEMA[_SCHEMA.index("CREATE TABLE IF NOT EXISTS reference_observations") :]
 
 
@@ -250,13 +260,41 @@ class Store:
                     self._insert_event("retry", self.run_info()["state"],
                                        f"hole {result.hole_id}: earlier attempt unmeasured",
                                        json.loads(old[0]))  # fmt: skip
+                    self._con.execute("DELETE FROM uncertainty WHERE hole_id = ?",
+                                      (result.hole_id,))  # fmt: skip
                     self._con.execute("DELETE FROM measurements WHERE hole_id = ?",
                                       (result.hole_id,))  # fmt: skip
                 self._con.execute("INSERT INTO measurements VALUES (?, ?, ?, ?, ?)", row)
+                for c in (result.budget or {}).get("components", []):
+                    self._con.execute(
+                        "INSERT INTO uncertainty VALUES (?, ?, ?, ?, ?)",
+                        (result.hole_id, c["name"], c["u_position_m"], c["u_diameter_m"],
+                         c["note"]),
+                    )  # fmt: skip
         except sqlite3.IntegrityError as exc:
             raise StoreError(
                 self.path, f"hole {result.hole_id!r} is already stored or not planned ({exc})"
             ) from exc
+
+    def uncertainty_rows(self) -> list[tuple[str, str, float, float, str]]:
+        """Every stored budget component: (hole id, component, u position m, u diameter m,
+        note), in stop order."""
+        return self._con.execute(
+            "SELECT u.hole_id, u.component, u.u_position_m, u.u_diameter_m, u.note FROM "
+            "uncertainty u JOIN measurements m USING (hole_id) ORDER BY m.stop_index, u.rowid"
+        ).fetchall()
+
+    # --- part temperature -------------------------------------------------------------------
+    def set_part_state(self, state: dict[str, Any]) -> None:
+        """Store the run's part temperature state (:class:`PartThermalState` as a mapping)."""
+        with self._con:
+            self._con.execute("INSERT OR REPLACE INTO meta VALUES ('part_state', ?)",
+                              (json.dumps(state),))  # fmt: skip
+
+    def part_state(self) -> dict[str, Any] | None:
+        """The stored part temperature state, or None."""
+        row = self._con.execute("SELECT value FROM meta WHERE key = 'part_state'").fetchone()
+        return None if row is None else json.loads(row[0])
 
     # --- thermal ----------------------------------------------------------------------------
     def set_thermal_reference(self, temps_degC: Any) -> None:

@@ -15,7 +15,7 @@ import multiprocessing
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -25,12 +25,14 @@ from cell.config import CellConfig, load_builtin_cell
 from cell.link.client import ControllerClient
 from cell.review.report import write_report
 from cell.run.reference import plan_reference_tour
-from cell.run.results import HoleResult
+from cell.run.results import HoleResult, deviations
 from cell.run.runner import Progress, Runner, RunOptions, RunResult
 from cell.run.setup import RunFiles, check_new_run_dir, start_run
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.world import SimWorld, WorldOptions
+from cell.uncertainty.decision import DEFAULT_RULE
+from cell.uncertainty.repeatability import repeatability_rp_m
 from planner import Options, Tour, TourPlanner
 from planner.tour import tour_from_dict
 from robots.transforms import invert
@@ -47,6 +49,15 @@ class DemoOptions:
         reference_interval_s: simulated seconds between two rounds.
         faults: what the simulated controller does wrong (none by default).
         seed: seed of the part's true geometry, sensor noise and image noise.
+        part_temperature_c: the simulated part's true temperature (degC); the run is given a
+            thermometer reading of it (``thermometer_sigma_K`` noise, stated as
+            ``u_part_temperature_K``).
+        realistic: the simulated cell has the errors a real one has and the budget claims:
+            the arm scatters by its data-sheet repeatability, the true head differs from its
+            calibration by a draw from the calibration's uncertainty, the part's expansion
+            coefficient by a draw from its material's (False: a perfect arm and head).
+        decision_rule: the run's decision rule.
+        operator: the report's operator field.
     """
 
     warmup_speed: float = 1500.0
@@ -55,17 +66,32 @@ class DemoOptions:
     reference_interval_s: float = 600.0
     faults: FaultPlan = field(default_factory=FaultPlan)
     seed: int = 0
+    part_temperature_c: float = 23.0
+    thermometer_sigma_K: float = 0.1  # noqa: N815 (unit suffix)
+    u_part_temperature_K: float = 0.2  # noqa: N815 (unit suffix)
+    realistic: bool = True
+    decision_rule: str = DEFAULT_RULE
+    operator: str = ""
 
 
 @dataclass
 class TruthError:
-    """Measured minus true hole centres (m, part frame) over the measured holes."""
+    """Measured minus true hole centres (m, part frame, at 20 degC) over the measured holes;
+    ``coverage``: the fraction of measured characteristics (position deviation and diameter of
+    each hole) whose true value lies within the stated expanded uncertainty (NaN: none)."""
 
     rms_m: float
     max_m: float
     rms_uncompensated_m: float
     diameter_rms_m: float
     n: int
+    coverage: float = float("nan")
+    n_covered: int = 0
+    n_characteristics: int = 0
+    position_covered: list[bool] = field(default_factory=list)
+    diameter_covered: list[bool] = field(default_factory=list)
+    rms_in_plane_m: float = float("nan")
+    max_in_plane_m: float = float("nan")
 
 
 @dataclass
@@ -81,9 +107,12 @@ class DemoResult:
 
 
 def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
-    """Measurement error against the simulation's true holes."""
+    """Measurement error against the simulation's true holes (their 20 degC geometry), and the
+    coverage of the stated uncertainties: ``|d - d_true| <= U_position`` for the position
+    deviation (in the plane of the nominal axis) and ``|D - D_true| <= U_diameter``."""
     T_part_cell = invert(world.cell.T_cell_part())
-    e, e_u, e_d = [], [], []
+    normals = {h.id: np.asarray(h.normal, float) for h in world.cell.part.holes}
+    e, e_u, e_d, e_p, cov_p, cov_d = [], [], [], [], [], []
     for r in results:
         if r.center_part_m is None:
             continue
@@ -92,11 +121,24 @@ def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
         e.append(np.linalg.norm(np.array(r.center_part_m) - true_c))
         e_u.append(np.linalg.norm(np.array(r.extra["center_part_uncompensated_m"]) - true_c))
         e_d.append(r.diameter_m - h.diameter_m)
+        n = normals[r.hole_id]
+        err = np.array(r.center_part_m) - true_c
+        e_p.append(np.linalg.norm(err - (err @ n) * n))
+        if r.U_position_m is not None:
+            nom = np.array(r.nominal_part_m)
+            d_true = deviations(true_c, h.diameter_m, nom, r.nominal_diameter_m, None,
+                                normals[r.hole_id])[0]  # fmt: skip
+            cov_p.append(bool(abs(r.position_deviation_m - d_true) <= r.U_position_m))
+            cov_d.append(bool(abs(r.diameter_m - h.diameter_m) <= r.U_diameter_m))
 
     def rms(v: list[float]) -> float:
         return float(np.sqrt(np.mean(np.square(v)))) if v else float("nan")
 
-    return TruthError(rms(e), float(max(e, default=float("nan"))), rms(e_u), rms(e_d), len(e))
+    covered = cov_p + cov_d
+    cov = float(np.mean(covered)) if covered else float("nan")
+    return TruthError(rms(e), float(max(e, default=float("nan"))), rms(e_u), rms(e_d), len(e),
+                      cov, int(np.sum(covered)), len(covered), cov_p, cov_d, rms(e_p),
+                      float(max(e_p, default=float("nan"))))  # fmt: skip
 
 
 def _plan_reference(seed: int) -> dict[str, Any]:
@@ -134,7 +176,7 @@ def run_demo(
     tour, reference = plan_demo(cell, opts.seed, plan_progress)
     t_plan = time.perf_counter() - t0
     # real time until the first reference round starts (its readings are the cold state)
-    world = WorldOptions(speed=1.0, drift_offset_s=0.0, seed=opts.seed)
+    world = demo_world(cell, opts)
     with SimCell.start(cell, world, opts.faults) as sim:
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
@@ -145,10 +187,28 @@ def run_demo(
             files.store.close()
             if recorder is not None:
                 recorder.close()
-    summary = write_report(out_dir)
+    summary = write_report(out_dir, opts.operator)
     timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
                "total_s": time.perf_counter() - t0}  # fmt: skip
     return DemoResult(Path(out_dir), tour, result, summary, truth, timings)
+
+
+def demo_world(cell: CellConfig, opts: DemoOptions) -> WorldOptions:
+    """The simulated cell of the demo: real time until the first reference round (its
+    readings are the cold state), the part at ``part_temperature_c``; with ``realistic`` the
+    arm's data-sheet repeatability, a true head off its calibration and a true expansion
+    coefficient off the material's figure, each drawn from the uncertainty the budget claims."""
+    base = WorldOptions(speed=1.0, drift_offset_s=0.0, seed=opts.seed,
+                        part_temperature_c=opts.part_temperature_c,
+                        part_thermometer_sigma_K=opts.thermometer_sigma_K)  # fmt: skip
+    if not opts.realistic:
+        return base
+    material, _ = cell.part_material()
+    rng = np.random.default_rng([opts.seed, 0xA1FA])
+    alpha = material.alpha_per_K + rng.normal(0.0, material.u_alpha_per_K)
+    rp, _ = repeatability_rp_m(cell.robot.model, cell.robot.repeatability_m)
+    return replace(base, repeatability_rp_m=rp, calibration_sigma_scale=1.0,
+                   part_alpha_per_K=alpha)  # fmt: skip
 
 
 def _speed_up(sim: SimCell, opts: DemoOptions, run_progress: Progress | None) -> Progress:
@@ -175,6 +235,9 @@ def _run_sim(
         settle_s=0.2 / opts.run_speed,
         reference_rounds=opts.reference_rounds,
         reference_interval_s=opts.reference_interval_s,
+        part_temperature_c=sim.world.part_reading_c(),
+        u_part_temperature_K=opts.u_part_temperature_K,
+        decision_rule=opts.decision_rule,
     )
     with ControllerClient(sim.url) as client:
         runner = Runner(files.cell, files.tour, files.store, client, sim.camera, run_opts,

@@ -4,18 +4,25 @@ through the (compensated) kinematics, compare with the nominal.
 Frames: the measurement comes in the LEFT camera optical frame; ``T_head_left`` (the inverse of
 :func:`measure.head_frame`) carries it into the head frame, which is the TCP;
 ``T_cell_tcp`` comes from the thermal model at the capture's joints and temperatures (or the
-nominal kinematics without a model); ``T_cell_part`` from the cell file.
+nominal kinematics without a model); ``T_cell_part`` from the cell file. The centre and diameter
+are then corrected to 20 degC
+(:mod:`cell.uncertainty.part_temperature`), the budget is formed
+(:mod:`cell.uncertainty.budget`) and the decision taken (:mod:`cell.uncertainty.decision`).
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from cell.config import CellConfig, HoleInCell
 from cell.run.results import HoleResult, deviations
+from cell.uncertainty.budget import combine
+from cell.uncertainty.context import BudgetContext, budget_context, hole_contributions
+from cell.uncertainty.decision import decide_hole, decide_one
 from measure import HoleMeasurement, MeasurementError, StereoCalibration, head_frame, measure_hole
 from measure.errors import HoleNotFoundError
 from robots import Arm
@@ -46,10 +53,12 @@ def inspect_hole(
     q_rad: np.ndarray,
     temps_c: np.ndarray,
     sim_time_s: float,
+    context: BudgetContext | None = None,
 ) -> tuple[HoleResult, HoleMeasurement | None]:
     """Measure ``hole`` from one pair and compare it with its nominal; never raises for a hole
     that is not there (``missing``) or cannot be measured (``unmeasured``: a resume retries
-    it)."""
+    it). ``context``: the run's budget inputs (default: the cell's, part temperature from the
+    cell file or assumed, ISO 14253-1 rule)."""
     T_part_cell = invert(cell.T_cell_part())
     nominal = T_part_cell[:3, :3] @ hole.position_m + T_part_cell[:3, 3]
     base = _base_fields(hole, stop_index, nominal, q_rad, temps_c, sim_time_s)
@@ -61,12 +70,34 @@ def inspect_hole(
     except MeasurementError as exc:
         return HoleResult(status="unmeasured", reason=f"not measurable: {exc}", **base), None
     t_meas = time.perf_counter() - t0
+    ctx = context or budget_context(cell, stereo)
     T_head_left = invert(head_frame(stereo))
     T_part_left = T_part_cell @ T_cell_tcp(arm, model, q_rad, temps_c) @ T_head_left
     T_nom = T_part_cell @ arm.fk(q_rad, "tcp") @ T_head_left
-    center_nominal_fk = T_nom[:3, :3] @ meas.center_m + T_nom[:3, 3]
+    center_nominal_fk = ctx.part.to_20c(T_nom[:3, :3] @ meas.center_m + T_nom[:3, 3])
     extra = {"center_part_uncompensated_m": [float(v) for v in center_nominal_fk]}
-    return _measured(meas, T_part_left, hole, nominal, t_meas, extra, base), meas
+    normal_part = T_part_cell[:3, :3] @ hole.normal
+    result = _measured(meas, T_part_left, hole, nominal, t_meas, extra, base, ctx, normal_part)
+    center_tcp = T_head_left[:3, :3] @ meas.center_m + T_head_left[:3, 3]
+    contributions = hole_contributions(
+        ctx, stereo, meas, T_part_left[:3, :3], T_part_cell[:3, :3], model, arm.T_cell_base,
+        arm.T_tool0_tcp, q_rad, temps_c, center_tcp, np.array(result.center_part_m),
+        result.diameter_m)  # fmt: skip
+    delta = np.array(result.center_part_m) - nominal
+    budget = combine(contributions, delta, normal_part, (ctx.part.note(),))
+    return _decided(result, budget, ctx.rule), meas
+
+
+def _decided(result: HoleResult, budget, rule: str) -> HoleResult:
+    """``result`` with its budget, expanded uncertainties and decision."""
+    decision = None
+    if result.tolerance_m is not None:
+        decision = decide_hole([
+            decide_one(result.position_deviation_m, budget.U_position_m, result.tolerance_m, rule),
+            decide_one(result.diameter_deviation_m, budget.U_diameter_m, result.tolerance_m, rule),
+        ])  # fmt: skip
+    return replace(result, U_position_m=budget.U_position_m, U_diameter_m=budget.U_diameter_m,
+                   decision=decision, decision_rule=rule, budget=budget.to_dict())  # fmt: skip
 
 
 def _base_fields(
@@ -98,22 +129,30 @@ def _measured(
     measure_time_s: float,
     extra: dict[str, Any],
     base: dict[str, Any],
+    ctx: BudgetContext,
+    normal_part_m: np.ndarray,
 ) -> HoleResult:
     """The result of a measured hole: centre and axis carried into the part frame by
-    ``T_part_left``, deviations and the verdict against the tolerance; ``suspect`` flags a
-    measurement of doubtful quality whatever the verdict."""
-    center = T_part_left[:3, :3] @ meas.center_m + T_part_left[:3, 3]
+    ``T_part_left``, centre and diameter corrected to 20 degC, deviations and the verdict
+    against the tolerance; ``suspect`` flags a measurement of doubtful quality whatever the
+    verdict."""
+    center_t = T_part_left[:3, :3] @ meas.center_m + T_part_left[:3, 3]
+    center = ctx.part.to_20c(center_t)
+    diameter = float(ctx.part.to_20c(meas.diameter_m))
     normal = T_part_left[:3, :3] @ meas.normal
-    dpos, ddia, ok = deviations(center, meas.diameter_m, nominal_part_m, hole.diameter_m,
-                                hole.tolerance_m)  # fmt: skip
+    extra = {**extra, "center_part_at_temperature_m": [float(v) for v in center_t],
+             "diameter_at_temperature_m": float(meas.diameter_m)}  # fmt: skip
+    dpos, ddia, ok, axial = deviations(center, diameter, nominal_part_m, hole.diameter_m,
+                                       hole.tolerance_m, normal_part_m)  # fmt: skip
     cov = np.asarray(meas.cov_center_radius, float)
     return HoleResult(
         status="suspect" if meas.status == "suspect" else ("ok" if ok else "fail"),
         passed=ok,
         center_part_m=tuple(float(v) for v in center),
         normal_part=tuple(float(v) for v in normal),
-        diameter_m=float(meas.diameter_m),
+        diameter_m=diameter,
         position_deviation_m=dpos,
+        axial_deviation_m=axial,
         diameter_deviation_m=ddia,
         u_center_m=float(np.sqrt(max(np.trace(cov[:3, :3]), 0.0))),
         u_diameter_m=float(2.0 * np.sqrt(max(cov[3, 3], 0.0))),

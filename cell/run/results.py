@@ -9,6 +9,13 @@ one should be; no measured values) or ``"unmeasured"`` (a hole was seen but coul
 no measured values; a resumed run tries it again). ``passed`` is the verdict against the
 tolerance from the deviations alone (True / False), None when the hole was not measured; a
 suspect hole keeps it.
+Positions and diameters are at 20 degC (ISO 1: corrected for the part's temperature);
+``position_deviation_m`` is the centre's distance from the nominal in the plane perpendicular to
+the nominal axis, ``axial_deviation_m`` the signed offset along it (out of the surface).
+``U_position_m`` / ``U_diameter_m`` are the expanded uncertainties (k = 2) of the budget
+``budget`` (:class:`cell.uncertainty.budget.HoleBudget` as a mapping), ``decision`` the ISO
+14253-1 decision (``conforming`` / ``inconclusive`` / ``nonconforming``; None when not measured
+or without a tolerance) under ``decision_rule``.
 ``thermal_model_id`` names the thermal model (row of the store's ``thermal_models``) the pose was
 compensated with; None: the nominal kinematics.
 """
@@ -50,6 +57,12 @@ class HoleResult:
     passed: bool | None = None
     thermal_model_id: int | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    axial_deviation_m: float | None = None
+    U_position_m: float | None = None
+    U_diameter_m: float | None = None
+    decision: str | None = None
+    decision_rule: str | None = None
+    budget: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
@@ -71,11 +84,20 @@ def deviations(
     nominal_part_m: np.ndarray,
     nominal_diameter_m: float,
     tolerance_m: float | None,
-) -> tuple[float, float, bool]:
-    """(position deviation (m), diameter deviation (m), pass). A hole passes when both the
-    centre distance and the absolute diameter deviation are within ``tolerance_m`` (always, if
-    the hole has no tolerance)."""
-    dpos = float(np.linalg.norm(np.asarray(center_part_m) - np.asarray(nominal_part_m)))
+    normal_part: np.ndarray | None = None,
+) -> tuple[float, float, bool, float]:
+    """(position deviation (m), diameter deviation (m), pass, axial deviation (m)). The position
+    deviation is the distance in the plane perpendicular to the nominal axis ``normal_part``
+    (the full distance without one; axial then 0). A hole passes when both the position
+    deviation and the absolute diameter deviation are within ``tolerance_m`` (always, if the
+    hole has no tolerance)."""
+    delta = np.asarray(center_part_m, float) - np.asarray(nominal_part_m, float)
+    axial = 0.0
+    if normal_part is not None:
+        n = np.asarray(normal_part, float) / np.linalg.norm(normal_part)
+        axial = float(delta @ n)
+        delta = delta - axial * n
+    dpos = float(np.linalg.norm(delta))
     ddia = float(diameter_m - nominal_diameter_m)
     ok = tolerance_m is None or (dpos <= tolerance_m and abs(ddia) <= tolerance_m)
-    return dpos, ddia, ok
+    return dpos, ddia, ok, axial

@@ -31,6 +31,9 @@ from cell.run.reference import target_of
 from cell.run.results import HoleResult
 from cell.run.thermal_record import remember_model, stored_model, stored_rows
 from cell.run.thermal_update import ThermalUpdate
+from cell.uncertainty.context import BudgetContext, budget_context
+from cell.uncertainty.decision import DEFAULT_RULE
+from cell.uncertainty.part_temperature import PartThermalState, part_state
 from measure import MeasurementError, head_frame, measure_hole
 from planner import Tour
 from robots.thermal.model import ThermalModel
@@ -55,6 +58,10 @@ class RunOptions:
             model is identified only from rounds at different temperatures, so at least two,
             ``reference_interval_s`` apart.
         reference_interval_s: controller-clock seconds between the starts of two rounds.
+        part_temperature_c: the part's temperature read for this run (degC; None: the one
+            stored by the run before a resume, else the cell file's or 20 degC assumed).
+        u_part_temperature_K: its standard uncertainty (K; None: 0.2 K, a contact thermometer).
+        decision_rule: ``iso14253`` (ISO 14253-1, with the expanded uncertainty) or ``simple``.
 
     The reference temperatures of an identified model are the first reference round's readings
     (the rule of ``holecell thermal identify``), not a fixed value.
@@ -65,6 +72,9 @@ class RunOptions:
     reconnect_budget_s: float = 15.0
     reference_rounds: int = 2
     reference_interval_s: float = 300.0
+    part_temperature_c: float | None = None
+    u_part_temperature_K: float | None = None  # noqa: N815 (unit suffix)
+    decision_rule: str = DEFAULT_RULE
 
 
 @dataclass
@@ -144,6 +154,7 @@ class Runner(Motion):
     def _run(self, result: RunResult, wait_for_start: Callable[[], None] | None) -> None:
         stored = self.store.done_ids()
         self._restore_thermal()
+        self.budget = self._budget_context()
         self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
         if wait_for_start is not None:
             wait_for_start()
@@ -207,6 +218,19 @@ class Runner(Motion):
         elif (latest := stored_model(self.store)) is not None:
             self.model_id, self.model = latest
             self.store.event("thermal", f"continuing with stored thermal model {self.model_id}")
+
+    def _budget_context(self) -> BudgetContext:
+        """The budget inputs: the part temperature given to this run (stored), else the one a
+        resumed run stored, else the cell file's or the assumed one (stored too)."""
+        o = self.options
+        stored = self.store.part_state()
+        if o.part_temperature_c is not None or stored is None:
+            part = part_state(self.cell, o.part_temperature_c, o.u_part_temperature_K)
+            self.store.set_part_state(part.to_dict())
+            self.store.event("part", part.note())
+        else:
+            part = PartThermalState.from_dict(stored)
+        return budget_context(self.cell, self.camera.stereo, part, o.decision_rule)
 
     # --- reference targets -----------------------------------------------------------------
     def _home_for_reference(self) -> None:
@@ -288,7 +312,7 @@ class Runner(Motion):
         clock.lap("capture_s")
         result, meas = inspect_hole(self.cell, self.arm, self.model, self.camera.stereo,
                                self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
-                               st.temperatures_c, st.time_s)  # fmt: skip
+                               st.temperatures_c, st.time_s, self.budget)  # fmt: skip
         result = replace(result, thermal_model_id=self.model_id if self.model else None)
         clock.lap("inspect_s")
         self.store.record_hole(result)

@@ -16,9 +16,27 @@ import numpy as np
 from cell.run.camera import StereoPair
 from cell.sim.controller import SimController
 from cell.sim.world import SimWorld, TrueHole
+from cell.uncertainty.calibration import (
+    N_PARAMETERS,
+    default_uncertainty,
+    parameter_sigmas,
+    perturbed,
+)
+from cell.uncertainty.repeatability import sigma_per_axis_m
 from measure import StereoCalibration, head_frame
 from measure.synth import RenderOptions, render_hole_pair, render_reference_pair
 from robots.transforms import invert
+
+
+def true_head(stereo: StereoCalibration, scale: float, seed: int) -> StereoCalibration:
+    """The head as it really is: the calibration ``stereo`` with every parameter off by a
+    normal draw of ``scale`` times its stated (or the default) standard deviation."""
+    if scale <= 0:
+        return stereo
+    unc = stereo.uncertainty or default_uncertainty(stereo)
+    rng = np.random.default_rng([seed, 0xCA11B])
+    return perturbed(stereo, scale * rng.normal(0.0, 1.0, N_PARAMETERS) * parameter_sigmas(unc))
+
 
 #: a feature counts as "in front of the head" within this distance of the view axis (m)
 VIEW_AXIS_TOL_M = 0.02
@@ -49,7 +67,10 @@ class SimCamera:
     ) -> None:
         self.world = world
         self.controller = controller
-        self.stereo = stereo
+        self.stereo = stereo  # the calibration file: what the runner measures with
+        o = world.options
+        self.true_stereo = true_head(stereo, o.calibration_sigma_scale, o.seed)
+        self._rep_sigma_m = sigma_per_axis_m(o.repeatability_rp_m)
         self.missing = set(missing_holes)
         self.render = render or RenderOptions()
         self._T_head_left = invert(head_frame(stereo))
@@ -67,14 +88,19 @@ class SimCamera:
             return self._capture(self.world.clock.now())
 
     def _capture(self, t: float) -> StereoPair:
-        T_cell_left = self.world.true_T_cell_tcp(self.controller.q_rad(), t) @ self._T_head_left
-        T_left_cell = invert(T_cell_left)
-        kind, feature = self._in_view(T_left_cell)
+        T_cell_tcp = self.world.true_T_cell_tcp(self.controller.q_rad(), t)
+        kind, feature = self._in_view(invert(T_cell_tcp @ self._T_head_left))
         key = feature.id if feature is not None else "none"
         seed = (self._seed * 1_000_003 + zlib.crc32(key.encode())) & 0x7FFFFFFF
+        if self._rep_sigma_m > 0:  # the arm's repeatability: this approach's scatter
+            rng = np.random.default_rng([self.world.options.seed, seed, self.captures])
+            T_cell_tcp = T_cell_tcp.copy()
+            T_cell_tcp[:3, 3] += rng.normal(0.0, self._rep_sigma_m, 3)
+        T_cell_left = T_cell_tcp @ self._T_head_left
+        T_left_cell = invert(T_cell_left)
         self.captures += 1
         if feature is None:  # bare surface facing the head, no hole anywhere near the view
-            pair = render_hole_pair(self.stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
+            pair = render_hole_pair(self.true_stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
             self.last_truth = CaptureTruth(None, "none", T_cell_left, None, None)
             return StereoPair(pair.left, pair.right)
         c = T_left_cell[:3, :3] @ feature.position_m + T_left_cell[:3, 3]
@@ -83,7 +109,7 @@ class SimCamera:
             u = np.cross(n, [1.0, 0.0, 0.0])
             c = c + 5.0 * u / np.linalg.norm(u)
         fn = render_reference_pair if kind == "reference" else render_hole_pair
-        pair = fn(self.stereo, c, n, feature.diameter_m, self.render, seed)
+        pair = fn(self.true_stereo, c, n, feature.diameter_m, self.render, seed)
         self.last_truth = CaptureTruth(
             feature.id, kind, T_cell_left, feature.position_m.copy(), feature.diameter_m
         )
@@ -92,7 +118,7 @@ class SimCamera:
     def _in_view(self, T_left_cell: np.ndarray) -> tuple[str, TrueHole | None]:
         T_head_cell = invert(self._T_head_left) @ T_left_cell
         best: tuple[float, str, TrueHole | None] = (VIEW_AXIS_TOL_M, "none", None)
-        candidates = [("hole", h) for h in self.world.holes.values()]
+        candidates = [("hole", h) for h in self.world.holes_at_temperature.values()]
         candidates += [("reference", r) for r in self.references.values()]
         for kind, f in candidates:
             p = T_head_cell[:3, :3] @ f.position_m + T_head_cell[:3, 3]

@@ -85,6 +85,16 @@ class WorldOptions:
             surface plane (m): the part as machined.
         diameter_sigma_m: standard deviation of each true diameter from nominal (m).
         seed: seed of the part errors and the sensor noise.
+        repeatability_rp_m: the arm's ISO 9283 pose repeatability RP (m): every capture's TCP
+            position scatters isotropically by ``RP / 3.616`` per axis (0: none).
+        calibration_sigma_scale: the true stereo head differs from its calibration file by a
+            draw of this many times the file's stated (or the default) uncertainties (0: the
+            file is exact).
+        part_temperature_c: the part's true temperature (degC); it expands about the part frame
+            origin from its 20 degC geometry by ``part_alpha_per_K``.
+        part_alpha_per_K: the part's true expansion coefficient (None: the cell's material
+            figure).
+        part_thermometer_sigma_K: standard deviation of a part temperature reading (K).
     """
 
     speed: float = 1.0
@@ -93,6 +103,11 @@ class WorldOptions:
     position_sigma_m: float = 15e-6
     diameter_sigma_m: float = 5e-6
     seed: int = 0
+    repeatability_rp_m: float = 0.0
+    calibration_sigma_scale: float = 0.0
+    part_temperature_c: float = 20.0
+    part_alpha_per_K: float | None = None  # noqa: N815 (unit suffix)
+    part_thermometer_sigma_K: float = 0.0  # noqa: N815 (unit suffix)
 
 
 class SimWorld:
@@ -108,6 +123,27 @@ class SimWorld:
         settings = self.options.drift or default_settings()
         self.drift = DriftTruth(self.arm.dh, settings, seed=self.options.seed)
         self.holes = self._true_holes(np.random.default_rng(self.options.seed))
+        o = self.options
+        self.part_alpha_per_K = (cell.part_material()[0].alpha_per_K
+                                 if o.part_alpha_per_K is None else o.part_alpha_per_K)  # fmt: skip
+        self.holes_at_temperature = self._expanded(self.holes)
+
+    def _expanded(self, holes: dict[str, TrueHole]) -> dict[str, TrueHole]:
+        """The true holes as they are at the part's temperature: the 20 degC geometry expanded
+        about the part frame origin (cell frame, m)."""
+        s = 1.0 + self.part_alpha_per_K * (self.options.part_temperature_c - 20.0)
+        T = np.asarray(self.cell.T_cell_part(), float)
+        out = {}
+        for k, h in holes.items():
+            p_part = T[:3, :3].T @ (h.position_m - T[:3, 3])
+            out[k] = TrueHole(h.id, T[:3, :3] @ (s * p_part) + T[:3, 3], h.normal, s * h.diameter_m)
+        return out
+
+    def part_reading_c(self) -> float:
+        """A reading of the part's temperature (degC): the truth plus the thermometer's noise."""
+        rng = np.random.default_rng([self.options.seed, 0x7A27])
+        return float(self.options.part_temperature_c
+                     + rng.normal(0.0, self.options.part_thermometer_sigma_K))  # fmt: skip
 
     def _true_holes(self, rng: np.random.Generator) -> dict[str, TrueHole]:
         out: dict[str, TrueHole] = {}

@@ -78,3 +78,24 @@ def test_run_default_reference_rounds_can_identify() -> None:
 
     args = build_parser().parse_args(["run", "t.json", "--port", "p", "--camera", "c"])
     assert args.reference_rounds == RunOptions().reference_rounds >= 2
+
+
+@pytest.mark.parametrize(
+    ("args", "word"),
+    [
+        (["--part-temperature", "293.15"], "kelvin"),
+        (["--part-temperature", "warm"], "not a number"),
+        (["--u-part-temperature", "-1"], "not positive"),
+        (["--decision", "lenient"], "invalid choice"),
+    ],
+)
+def test_run_refuses_bad_part_temperature_and_rule(
+    small_cell: SmallCell, tmp_path: Path, capsys, args: list[str], word: str
+) -> None:
+    """Refused by the argument parser (exit 2) with the option named; nothing is written."""
+    with pytest.raises(SystemExit) as exc:
+        main([*_run(small_cell, tmp_path / "r"), *args])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert args[0] in err and word in err
+    assert not (tmp_path / "r").exists()

@@ -29,9 +29,12 @@ def _inspect(sc: SmallCell, monkeypatch, status: str, offset_m: float) -> HoleRe
     hole = dataclasses.replace(hole, tolerance_m=50e-6)
     T_left_cell = invert(arm.fk(np.asarray(stop.q), "tcp") @ invert(head_frame(stereo)))
     center = T_left_cell[:3, :3] @ hole.position_m + T_left_cell[:3, 3] + [offset_m, 0.0, 0.0]
+    t = np.linspace(0.0, 2 * np.pi, 100, endpoint=False)[:, None]
+    rim = center + 0.5 * hole.diameter_m * (np.cos(t) * [1.0, 0, 0] + np.sin(t) * [0, 1.0, 0])
     meas = SimpleNamespace(status=status, center_m=center, normal=np.array([0.0, 0.0, -1.0]),
                            diameter_m=hole.diameter_m, cov_center_radius=np.eye(4) * 1e-12,
-                           rms_m=1e-6, n_points=100)  # fmt: skip
+                           rms_m=1e-6, n_points=100, points_m=rim,
+                           inliers=np.ones(100, bool))  # fmt: skip
     monkeypatch.setattr(ih, "measure_hole", lambda *a, **k: meas)
     img = np.zeros((4, 4), np.uint8)
     result, _ = ih.inspect_hole(cell, arm, None, stereo, hole, 0, img, img,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 from pathlib import Path
 
@@ -129,3 +130,35 @@ def test_version_1_store_is_upgraded_without_loss(tmp_path: Path) -> None:
         assert [r.hole_id for r in s.results()] == ["H1"]
         s.record_reference(0, 1.0, "R1", [0.0] * 6, [20.0] * 6, [0.0, 0.0, 0.3])
         assert s.record_model("given", "{}") == 1 and len(s.reference_observations()) == 1
+
+
+def test_version_2_store_is_upgraded_and_keeps_budgets(tmp_path: Path) -> None:
+    """A schema-2 store gets the uncertainty table; a hole's budget components are stored in
+    it, and an unmeasured attempt's rows go with the attempt."""
+    import sqlite3
+
+    with _store(tmp_path) as s:
+        s.record_hole(_result("H1", 0))
+    con = sqlite3.connect(tmp_path / "results.sqlite")
+    with con:
+        con.execute("DROP TABLE uncertainty")
+        con.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
+    con.close()
+    budget = {"k": 2.0, "u_position_m": 1e-5, "u_diameter_m": 2e-6, "U_position_m": 2e-5,
+              "U_diameter_m": 4e-6, "notes": [],
+              "components": [{"name": "circle_fit", "u_position_m": 1e-6, "u_diameter_m": 1e-6,
+                              "note": "fit"},
+                             {"name": "robot_repeatability", "u_position_m": 9e-6,
+                              "u_diameter_m": 0.0, "note": "RP"}]}  # fmt: skip
+    with Store.open(tmp_path) as s:
+        s.record_hole(dataclasses.replace(_result("H2", 1), budget=budget, U_position_m=2e-5,
+                                          decision="conforming"))  # fmt: skip
+        rows = s.uncertainty_rows()
+        assert [(h, c) for h, c, *_ in rows] == [("H2", "circle_fit"),
+                                                 ("H2", "robot_repeatability")]  # fmt: skip
+        assert s.results()[1].decision == "conforming" and s.results()[0].decision is None
+        s.set_part_state({"temperature_c": 21.0})
+        assert s.part_state() == {"temperature_c": 21.0}
+    con = sqlite3.connect(tmp_path / "results.sqlite")
+    assert con.execute("SELECT value FROM meta WHERE key='schema_version'").fetchone()[0] == "3"
+    con.close()

@@ -1,0 +1,271 @@
+"""``report.html``: the inspection protocol of a run, one self-contained file.
+
+A CMM-style report: a header (cell, part, run, dates, operator, temperatures, decision rule),
+the counts, one table row per hole (nominal, actual, deviation, U, tolerance, decision), three
+plots as inline SVG (deviation vectors over the part, deviations against the tolerance with U,
+the thermal state over the run) and the uncertainty budget. No script, no stylesheet or font
+from the network: it opens and prints anywhere. Lengths shown in mm and um (the headers say
+which); positions and diameters at 20 degC.
+
+The hole table is ``<table id="holes">`` with one ``<tr class="hole" data-hole=ID
+data-decision=...>`` per planned hole (a test reads it back with :mod:`html.parser`).
+"""
+
+from __future__ import annotations
+
+import time
+from html import escape
+from typing import Any
+
+import numpy as np
+
+from cell.review.svg import COLORS, SERIES, Axes, frame, line, svg, text, ticks
+from cell.run.results import HoleResult
+from cell.uncertainty.budget import COMPONENTS
+
+DECISION_LABEL = {"conforming": "conformance proven", "inconclusive": "inconclusive",
+                  "nonconforming": "nonconformance proven", None: "-"}  # fmt: skip
+CSS = """
+body{font-family:Helvetica,Arial,sans-serif;margin:24px;color:#222;font-size:13px}
+h1{font-size:20px;margin:0 0 4px}h2{font-size:15px;margin:22px 0 6px;border-bottom:1px solid #999}
+table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:right}
+th{background:#eee}td.l,th.l{text-align:left}
+.hdr td{text-align:left;border:none;padding:1px 12px 1px 0}
+.conforming{color:#2e7d32;font-weight:bold}.inconclusive{color:#b36b00;font-weight:bold}
+.nonconforming{color:#c62828;font-weight:bold}.note{color:#555;font-size:12px}
+.counts span{display:inline-block;margin-right:18px;font-size:14px}
+"""
+
+
+def _fmt(v: float | None, scale: float, digits: int) -> str:
+    return "" if v is None else f"{v * scale:.{digits}f}"
+
+
+def _date(t: float | None) -> str:
+    return "-" if t is None else time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime(t))
+
+
+def _header(summ: dict[str, Any], info: dict[str, Any], operator: str,
+            results: list[HoleResult]) -> str:  # fmt: skip
+    part = summ.get("part") or {}
+    temps = np.array([r.temperatures_c for r in results if r.temperatures_c], float)
+    arm = (f"{temps.min():.1f} .. {temps.max():.1f} degC over {temps.shape[1]} sensors"
+           if temps.size else "-")  # fmt: skip
+    ptemp = (f"{part['temperature_c']:.2f} degC +- {part['u_temperature_K']:.2f} K "
+             f"({part['source']}); {part['material']}, alpha {part['alpha_per_K'] * 1e6:.2f} "
+             f"+- {part['u_alpha_per_K'] * 1e6:.2f} ppm/K" if part else "-")  # fmt: skip
+    rows = [("Cell", f"{summ['cell']} (SHA-256 {summ['cell_sha256'][:12]})"),
+            ("Part", f"{len(results)} of {summ['holes_planned']} holes stored"),
+            ("Robot", summ["robot_model"]), ("Run", info.get("run_dir", "")),
+            ("Cell file", info.get("cell_path", "")),
+            ("Run state", summ["state"]), ("Started", _date(summ["started_at"])),
+            ("Finished", _date(summ["finished_at"])),
+            ("Operator", operator or "_" * 28 + "   signature " + "_" * 20),
+            ("Part temperature", ptemp), ("Arm temperatures", arm),
+            ("Reference temperature", "20 degC (ISO 1): every position and diameter is reported "
+                                      "at 20 degC"),
+            ("Decision rule", (summ.get("decision_rule") or "-") + " (ISO 14253-1: conformance "
+             "proven when |deviation| + U <= tolerance; U expanded, k = 2)")]  # fmt: skip
+    body = "".join(f"<tr><td><b>{escape(k)}</b></td><td>{escape(str(v))}</td></tr>"
+                   for k, v in rows)  # fmt: skip
+    return f'<table class="hdr">{body}</table>'
+
+
+def _counts(summ: dict[str, Any]) -> str:
+    items = [("measured", summ["holes_measured"]), ("missing", summ["holes_missing"]),
+             ("not measurable", summ["holes_unmeasured"]),
+             ("not reached", summ["holes_not_reached"]),
+             ("conformance proven", summ["holes_conforming"]),
+             ("inconclusive", summ["holes_inconclusive"]),
+             ("nonconformance proven", summ["holes_nonconforming"])]  # fmt: skip
+    return '<p class="counts">' + "".join(
+        f'<span id="count-{k.replace(" ", "-")}">{escape(k)}: <b>{v}</b></span>' for k, v in items
+    ) + "</p>"  # fmt: skip
+
+
+def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]]) -> str:
+    head = ("<tr><th class='l'>hole</th><th>stop</th><th>nominal x / y / z (mm)</th>"
+            "<th>actual x / y / z (mm)</th><th>position dev. (um)</th><th>U pos. (um)</th>"
+            "<th>nominal dia. (mm)</th><th>actual dia. (mm)</th><th>dia. dev. (um)</th>"
+            "<th>U dia. (um)</th><th>tolerance (um)</th><th class='l'>decision</th>"
+            "<th class='l'>status</th></tr>")  # fmt: skip
+    by_id = {r.hole_id: r for r in results}
+    rows = []
+    for hole_id, stop, nominal in planned:
+        r = by_id.get(hole_id)
+        nom = nominal.get("position_part_m") or (r.nominal_part_m if r else None)
+        nom_s = " / ".join(f"{v * 1e3:.3f}" for v in nom) if nom else ""
+        if r is None:
+            rows.append(f'<tr class="hole" data-hole="{escape(hole_id)}" data-decision="">'
+                        f"<td class='l'>{escape(hole_id)}</td><td>{stop}</td><td>{nom_s}</td>"
+                        + "<td></td>" * 9 + "<td class='l'>not reached</td></tr>")  # fmt: skip
+            continue
+        act = " / ".join(f"{v * 1e3:.3f}" for v in r.center_part_m) if r.center_part_m else ""
+        dec = r.decision
+        cls = dec or ""
+        status = r.status + (f": {r.reason}" if r.reason else "")
+        rows.append(
+            f'<tr class="hole" data-hole="{escape(r.hole_id)}" data-decision="{cls}">'
+            f"<td class='l'>{escape(r.hole_id)}</td><td>{r.stop_index}</td><td>{nom_s}</td>"
+            f"<td>{act}</td><td>{_fmt(r.position_deviation_m, 1e6, 1)}</td>"
+            f"<td class='U'>{_fmt(r.U_position_m, 1e6, 1)}</td>"
+            f"<td>{_fmt(r.nominal_diameter_m, 1e3, 3)}</td><td>{_fmt(r.diameter_m, 1e3, 4)}</td>"
+            f"<td>{_fmt(r.diameter_deviation_m, 1e6, 1)}</td>"
+            f"<td class='U'>{_fmt(r.U_diameter_m, 1e6, 1)}</td>"
+            f"<td>{_fmt(r.tolerance_m, 1e6, 0)}</td>"
+            f"<td class='l decision {cls}'>{DECISION_LABEL.get(dec, dec)}</td>"
+            f"<td class='l'>{escape(status)}</td></tr>")  # fmt: skip
+    return f'<table id="holes">{head}{"".join(rows)}</table>'
+
+
+def _in_plane(r: HoleResult) -> np.ndarray:
+    """The centre's deviation without its axial part (part frame, m)."""
+    delta = np.subtract(r.center_part_m, r.nominal_part_m)
+    if r.axial_deviation_m is None or r.normal_part is None:
+        return delta
+    return delta - r.axial_deviation_m * np.asarray(r.normal_part, float)
+
+
+def _vector_plot(results: list[HoleResult]) -> str:
+    """Deviation vectors over the part: side view (part x, z), arrows magnified."""
+    m = [r for r in results if r.measured]
+    W, H = 900, 420
+    if not m:
+        return svg(W, 60, [text(10, 30, "no measured hole")], "deviation vectors")
+    nom = np.array([r.nominal_part_m for r in m]) * 1e3
+    dev = np.array([_in_plane(r) for r in m]) * 1e6
+    pad = 40.0
+    ax = Axes(W, H, (nom[:, 0].min() - pad, nom[:, 0].max() + pad),
+              (nom[:, 2].min() - pad, nom[:, 2].max() + pad))  # fmt: skip
+    per_um = 1.0  # arrow length: 1 px per um
+    body = frame(ax, "part x (mm)", "part z (mm)", ticks(*ax.xlim), ticks(*ax.ylim))
+    for r, p, d in zip(m, nom, dev, strict=True):
+        x, y = ax.x(p[0]), ax.y(p[2])
+        c = COLORS.get(r.decision, "#757575")
+        body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="3" fill="{c}"/>')
+        body.append(line(x, y, x + per_um * d[0], y - per_um * d[2], c, 1.6))
+        body.append(text(x + 4, y - 4, r.hole_id, 8, fill="#555"))
+    body.append(line(W - 180, 30, W - 130, 30, "#000", 1.6))
+    body.append(text(W - 125, 34, "50 um of deviation", 10))
+    body.append(text(ax.left + 6, ax.top + 14, "in-plane deviation of each hole, seen from the "
+                     "robot's side (part y toward the viewer)", 10, fill="#555"))  # fmt: skip
+    return svg(W, H, body, "deviation vectors over the part (side view, x-z)")
+
+
+def _bar_plot(results: list[HoleResult], key: str, ukey: str, label: str) -> str:
+    """|deviation| per hole with its U as an error bar, and the tolerance."""
+    m = [r for r in results if r.measured and getattr(r, key) is not None]
+    W, row = 900, 13
+    H = 60 + row * max(len(m), 1)
+    if not m:
+        return svg(W, 60, [text(10, 30, "no measured hole")], label)
+    vals = np.array([abs(getattr(r, key)) for r in m]) * 1e6
+    us = np.array([getattr(r, ukey) or 0.0 for r in m]) * 1e6
+    tol = max((r.tolerance_m or 0.0) for r in m) * 1e6
+    hi = max(float((vals + us).max()), tol) * 1.08
+    ax = Axes(W, H, (0.0, hi), (0.0, float(len(m))), margin=(70, 20, 10, 35))
+    body = frame(ax, f"{label} (um)", "", ticks(0.0, hi), [])
+    for i, (r, v, u) in enumerate(zip(m, vals, us, strict=True)):
+        y0, y1 = ax.y(len(m) - i), ax.y(len(m) - i - 1)
+        c = COLORS.get(r.decision, "#757575")
+        yb, hb = y0 + 2, max(y1 - y0 - 4, 1)
+        body.append(f'<rect x="{ax.x(0):.1f}" y="{yb:.1f}" width="{ax.x(v) - ax.x(0):.1f}" '
+                    f'height="{hb:.1f}" fill="{c}" opacity="0.75"/>')  # fmt: skip
+        ym = (y0 + y1) / 2
+        body += [line(ax.x(max(v - u, 0)), ym, ax.x(v + u), ym, "#000", 1.2),
+                 line(ax.x(v + u), ym - 3, ax.x(v + u), ym + 3, "#000", 1.2),
+                 text(ax.left - 4, ym + 3, r.hole_id, 8, "end")]  # fmt: skip
+    if tol > 0:
+        body.append(line(ax.x(tol), ax.top, ax.x(tol), H - ax.bottom, "#c62828", 1.5, "5,3"))
+        body.append(text(ax.x(tol) + 3, ax.top + 10, f"tolerance {tol:g} um", 10, fill="#c62828"))
+    return svg(W, H, body, f"{label} against the tolerance, with U (k = 2)")
+
+
+def _thermal_plot(results: list[HoleResult], reference: list[tuple[float, Any]]) -> str:
+    """Sensor readings over the run's controller time (reference rounds and holes), the
+    inspection window shaded, and the thermal compensation applied."""
+    m = [r for r in results if r.temperatures_c]
+    W, H = 900, 300
+    if not m and not reference:
+        return svg(W, 60, [text(10, 30, "no temperatures recorded")], "thermal drift")
+    rows = sorted([(float(t), np.asarray(T, float)) for t, T in reference]
+                  + [(r.sim_time_s, np.asarray(r.temperatures_c, float)) for r in m],
+                  key=lambda x: x[0])  # fmt: skip
+    t = np.array([a for a, _ in rows]) / 60.0
+    temps = np.array([b for _, b in rows])
+    ax = Axes(W, H, (t.min(), t.max() if t.max() > t.min() else t.min() + 1),
+              (temps.min() - 0.5, temps.max() + 0.5), margin=(60, 220, 20, 40))  # fmt: skip
+    body = frame(ax, "controller time (min)", "sensor reading (degC)", ticks(*ax.xlim),
+                 ticks(*ax.ylim))  # fmt: skip
+    if m:
+        t0, t1 = min(r.sim_time_s for r in m) / 60.0, max(r.sim_time_s for r in m) / 60.0
+        body.append(
+            f'<rect x="{ax.x(t0):.1f}" y="{ax.top}" width="{max(ax.x(t1) - ax.x(t0), 2):.1f}" '
+            f'height="{ax.h - ax.top - ax.bottom}" fill="#1565c0" opacity="0.08"/>'
+        )
+        body.append(text(ax.x(t0) - 4, ax.top + 12, "holes", 10, "end", fill="#1565c0"))
+    for j in range(temps.shape[1]):
+        pts = " ".join(f"{ax.x(a):.1f},{ax.y(b):.1f}" for a, b in zip(t, temps[:, j], strict=True))
+        c = SERIES[j % len(SERIES)]
+        body.append(f'<polyline points="{pts}" fill="none" stroke="{c}" stroke-width="1.5"/>')
+        body.append(text(W - 210, 30 + 14 * j, f"sensor {j + 1}", 10, fill=c))
+    comp = [np.linalg.norm(np.subtract(r.center_part_m, r.extra["center_part_uncompensated_m"]))
+            for r in m if r.measured and "center_part_uncompensated_m" in r.extra]  # fmt: skip
+    if comp:
+        lo, hi = np.min(comp) * 1e6, np.max(comp) * 1e6
+        body.append(text(W - 210, 40 + 14 * temps.shape[1],
+                         f"compensation applied: {lo:.0f}..{hi:.0f} um", 10))  # fmt: skip
+    return svg(W, H, body, "thermal state over the run")
+
+
+def _budget_table(results: list[HoleResult]) -> str:
+    rows = {c: ([], []) for c in COMPONENTS}
+    notes: dict[str, str] = {}
+    for r in results:
+        for c in (r.budget or {}).get("components", []):
+            rows.setdefault(c["name"], ([], []))
+            rows[c["name"]][0].append(c["u_position_m"])
+            rows[c["name"]][1].append(c["u_diameter_m"])
+            notes[c["name"]] = c["note"]
+    head = (
+        "<tr><th class='l'>component</th><th>u position, median / max (um)</th>"
+        "<th>u diameter, median / max (um)</th><th class='l'>source</th></tr>"
+    )
+    body = []
+    for name, (p, d) in rows.items():
+        if not p:
+            continue
+        body.append(f"<tr><td class='l'>{escape(name)}</td>"
+                    f"<td>{np.median(p) * 1e6:.2f} / {np.max(p) * 1e6:.2f}</td>"
+                    f"<td>{np.median(d) * 1e6:.2f} / {np.max(d) * 1e6:.2f}</td>"
+                    f"<td class='l note'>{escape(notes.get(name, ''))}</td></tr>")  # fmt: skip
+    if not body:
+        return "<p>no budget stored (a run from before the uncertainty budget)</p>"
+    return f'<table id="budget">{head}{"".join(body)}</table>'
+
+
+def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleResult],
+                planned: list[tuple[str, int, dict]], operator: str = "",
+                reference: list[tuple[float, Any]] | None = None) -> str:  # fmt: skip
+    """The whole ``report.html`` document; ``reference``: (controller time s, readings degC)
+    of the reference-target observations, for the thermal plot."""
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>Inspection report {escape(summ['cell'])}</title><style>{CSS}</style></head><body>",
+        f"<h1>Inspection report: {escape(summ['cell'])}</h1>",
+        _header(summ, info, operator, results),
+        "<h2>Result</h2>", _counts(summ),
+        "<h2>Holes</h2>", _hole_table(results, planned),
+        "<p class='note'>Position deviation: distance of the measured centre from the nominal in "
+        "the plane perpendicular to the nominal axis. U: expanded uncertainty (k = 2) of the "
+        "budget below. Decisions per ISO 14253-1 on both characteristics.</p>",
+        "<h2>Deviation vectors over the part</h2>", _vector_plot(results),
+        "<h2>Position deviation against the tolerance</h2>",
+        _bar_plot(results, "position_deviation_m", "U_position_m", "position deviation"),
+        "<h2>Diameter deviation against the tolerance</h2>",
+        _bar_plot(results, "diameter_deviation_m", "U_diameter_m", "|diameter deviation|"),
+        "<h2>Thermal drift over the run</h2>", _thermal_plot(results, reference or []),
+        "<h2>Uncertainty budget (standard uncertainties, GUM)</h2>", _budget_table(results),
+        f"<p class='note'>written {_date(time.time())} by holecell</p></body></html>",
+    ]  # fmt: skip
+    return "\n".join(parts)
