@@ -9,11 +9,10 @@ the hole is the longest *plateau* — consecutive levels giving the same diamete
 4 % — and of equal plateaus the darker one: a sharp rim gives the same region over a
 wide range of levels, while a chamfer ring, a shadow or a soft lip joins the region only
 at some levels. A small disc inside a larger one (a dark fragment of a screw or its
-shadow inside the bore) belongs to the larger one and is dropped, and so is a disc seen
-at one level only when others hold over two or more (a shadow or a stain next to the
-hole). If no dark disc is
-found, the bright class is searched the same way (a through-hole against a lit
-background). Regions cut by the border are kept and flagged, so the caller can say so
+shadow inside the bore) belongs to the larger one and is dropped. Discs that hold over
+two or more levels come first (a shadow or a stain next to the hole, or texture near the
+surface level, shows at one level only): dark ones, else bright ones (a through-hole
+against a lit background), and only if there are none, one-level discs. Regions cut by the border are kept and flagged, so the caller can say so
 instead of "no hole".
 
 Images may be ``uint8`` or ``uint16`` holding 8 to 16 significant bits, single-channel or
@@ -206,7 +205,10 @@ def _plateau(members: list[tuple]) -> tuple:
 
 
 def _group(discs: list[tuple]) -> list[tuple]:
-    """Group discs found at several levels into holes; drop discs inside a larger hole."""
+    """Group discs found at several levels into holes; drop discs inside a larger hole.
+
+    Returns (cx, cy, area, bbox, border, level, plateau length) per hole.
+    """
     groups: list[list[tuple]] = []
     for d in sorted(discs, key=lambda d: -d[2]):
         r = np.sqrt(d[2] / np.pi)
@@ -219,17 +221,14 @@ def _group(discs: list[tuple]) -> list[tuple]:
         else:
             groups.append([d])
     picks = [_plateau(g) for g in groups]
-    if any(p[6] >= 2 for p in picks):  # a rim holds over levels; a shadow or a stain does not
-        picks = [p for p in picks if p[6] >= 2]
-    keep = []
-    for p in picks:
-        inside = any(
+    return [
+        p
+        for p in picks
+        if not any(
             q[2] > p[2] and np.hypot(p[0] - q[0], p[1] - q[1]) < np.sqrt(q[2] / np.pi)
             for q in picks
         )
-        if not inside:
-            keep.append(p)
-    return keep
+    ]
 
 
 def find_candidates(
@@ -252,12 +251,20 @@ def find_candidates(
         if min(small.shape) < 4:
             return []
     min_area = np.pi * (0.5 * min_diameter_px / s) ** 2
+    found = []
     for polarity, thresholds in _levels(small):
         discs = []
         for k, thr in enumerate(thresholds):
             mask = (small <= thr) if polarity == "dark" else (small > thr)
             discs += _discs(mask, min_area, k)
-        if not discs:
+        holes = _group(discs)
+        stable = [h for h in holes if h[6] >= 2]  # a rim holds over levels, a stain does not
+        found.append((polarity, thresholds, stable, holes))
+    # dark discs that hold over levels, else bright ones, else any dark, else any bright
+    for polarity, thresholds, holes in [(p, t, st) for p, t, st, _ in found] + [
+        (p, t, h) for p, t, _, h in found
+    ]:
+        if not holes:
             continue
         return [
             HoleCandidate(
@@ -269,6 +276,6 @@ def find_candidates(
                 touches_border=border,
                 levels=n_levels,
             )
-            for cx, cy, area, (bx, by, bw, bh), border, level, n_levels in _group(discs)
+            for cx, cy, area, (bx, by, bw, bh), border, level, n_levels in holes
         ]
     return []

@@ -94,7 +94,10 @@ def hole_region(
     The candidate's threshold gives a first outline; the gray levels just inside it and
     in a ring 3 … 3 + max(4, 3 % of the diameter) px outside it set a local threshold
     midway between the two, which draws the final outline. So the outline follows the
-    rim where the light is uneven, and lies on the middle of a soft edge.
+    rim where the light is uneven, and lies on the middle of a soft edge. For a bright
+    interior (a through-hole against a lit background) pixels as far *below* the
+    surrounding level are part of the hole too: the bore wall, seen at a tilt as a dark
+    crescent between the background and the rim.
     """
     H, W = img.shape
     x, y, w, h = cand.bbox
@@ -117,7 +120,10 @@ def hole_region(
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
-            mask = (roi_img <= level * full) if dark else (roi_img > level * full)
+            if dark:
+                mask = roi_img <= level * full
+            else:  # a lit background: the bore wall seen at a tilt is a dark crescent
+                mask = (roi_img > level * full) | (roi_img < (2 * lout - level) * full)
             refined = _region(mask, seed)
             ratio = float(refined.sum()) / float(region.sum())
             if 0.6 < ratio < 1.6:  # the same region, better placed; else keep the first
