@@ -12,8 +12,11 @@ at some levels. A small disc inside a larger one (a dark fragment of a screw or 
 shadow inside the bore) belongs to the larger one and is dropped. Discs that hold over
 two or more levels come first (a shadow or a stain next to the hole, or texture near the
 surface level, shows at one level only): dark ones, else bright ones (a through-hole
-against a lit background), and only if there are none, one-level discs. Regions cut by the border are kept and flagged, so the caller can say so
-instead of "no hole".
+against a lit background), and only if there are none, one-level discs. A dark disc
+inside a bright one is a bore inside a grommet when the two are concentric (the bright
+one goes), the bore wall's crescent beside a lit background when not (the dark one goes).
+Regions cut by the border are kept and flagged, so the caller can say so instead of
+"no hole".
 
 Images may be ``uint8`` or ``uint16`` holding 8 to 16 significant bits, single-channel or
 colour (converted to luma); see :func:`to_gray` and :func:`full_scale`.
@@ -231,6 +234,31 @@ def _group(discs: list[tuple]) -> list[tuple]:
     ]
 
 
+def _cross_polarity(found: dict[str, tuple[list, list]]) -> None:
+    """Settle dark discs lying inside bright ones (in place).
+
+    Concentric (centres within 15 % of the bright radius): a dark bore inside a bright
+    grommet or washer — the bright disc goes. Off-centre: the dark crescent of the bore
+    wall beside a lit background seen through the hole — the dark disc goes.
+    """
+    if "dark" not in found or "bright" not in found:
+        return
+    dark, bright = found["dark"][1], found["bright"][1]
+    drop_dark, drop_bright = set(), set()
+    for i, d in enumerate(dark):
+        for j, b in enumerate(bright):
+            rb = np.sqrt(b[2] / np.pi)
+            off = np.hypot(d[0] - b[0], d[1] - b[1])
+            if d[2] >= b[2] or off >= rb:
+                continue
+            if off < 0.15 * rb:
+                drop_bright.add(j)
+            else:
+                drop_dark.add(i)
+    found["dark"][1][:] = [d for i, d in enumerate(dark) if i not in drop_dark]
+    found["bright"][1][:] = [b for j, b in enumerate(bright) if j not in drop_bright]
+
+
 def find_candidates(
     small: np.ndarray,
     roi: tuple[int, int, int, int] | None = None,
@@ -251,19 +279,18 @@ def find_candidates(
         if min(small.shape) < 4:
             return []
     min_area = np.pi * (0.5 * min_diameter_px / s) ** 2
-    found = []
+    found = {}
     for polarity, thresholds in _levels(small):
         discs = []
         for k, thr in enumerate(thresholds):
             mask = (small <= thr) if polarity == "dark" else (small > thr)
             discs += _discs(mask, min_area, k)
-        holes = _group(discs)
-        stable = [h for h in holes if h[6] >= 2]  # a rim holds over levels, a stain does not
-        found.append((polarity, thresholds, stable, holes))
+        found[polarity] = (thresholds, _group(discs))
+    _cross_polarity(found)
     # dark discs that hold over levels, else bright ones, else any dark, else any bright
-    for polarity, thresholds, holes in [(p, t, st) for p, t, st, _ in found] + [
-        (p, t, h) for p, t, _, h in found
-    ]:
+    order = [(p, t, [h for h in hs if h[6] >= 2]) for p, (t, hs) in found.items()]
+    order += [(p, t, hs) for p, (t, hs) in found.items()]
+    for polarity, thresholds, holes in order:
         if not holes:
             continue
         return [

@@ -31,7 +31,8 @@ class HoleRegion:
 
     ``inside_level`` / ``outside_level`` are the median gray levels (fractions of full
     scale) just inside the outline and in a ring just outside it; ``threshold`` the level
-    midway between them that drew the outline.
+    midway between them that drew the outline; ``ring_level`` the median in a wider ring
+    5 … 20 % of the diameter outside the outline (a grommet or washer shows there).
     """
 
     roi: tuple[int, int, int, int]
@@ -41,6 +42,7 @@ class HoleRegion:
     threshold: float = 0.0
     inside_level: float = 0.0
     outside_level: float = 0.0
+    ring_level: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -130,9 +132,20 @@ def hole_region(
                 region = refined
     mom = cv2.moments(region, binaryImage=True)
     if mom["m00"] <= 0:
-        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside)
+        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
     centroid = (mom["m10"] / mom["m00"] + x0, mom["m01"] / mom["m00"] + y0)
-    return HoleRegion(box, centroid, float(mom["m00"]), region > 0, level, inside, outside)
+    d = 2.0 * np.sqrt(mom["m00"] / np.pi)
+    wide = _median(roi_img, _ring(region, int(0.05 * d) + 1, int(0.2 * d) + 2), full)
+    return HoleRegion(
+        box,
+        centroid,
+        float(mom["m00"]),
+        region > 0,
+        level,
+        inside,
+        outside,
+        outside if wide is None else wide,
+    )
 
 
 def outline_band(region: np.ndarray, half_width: int) -> np.ndarray:

@@ -15,7 +15,7 @@ import numpy as np
 from measure.calibration import StereoCalibration
 from measure.circle import fit_circle_3d
 from measure.contour import Contour, build_contour
-from measure.detect import HoleCandidate, check_image, find_candidates, quantiles_u8, to_gray
+from measure.detect import SEARCH_SCALE, HoleCandidate, check_image, find_candidates, to_gray
 from measure.edges import HoleRegion, hole_region, subpixel_edges
 from measure.errors import (
     EdgeError,
@@ -74,11 +74,26 @@ def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour
     return contour, region
 
 
+def _surface_level(small: np.ndarray, cand: HoleCandidate) -> float:
+    """Median of the search image in an annulus 1.0 … 1.5 diameters from the hole's centre:
+    the part's surface beyond any grommet or washer (fraction of full scale)."""
+    s = SEARCH_SCALE
+    cx, cy = (cand.centroid_px[0] - s // 2) / s, (cand.centroid_px[1] - s // 2) / s
+    d = cand.diameter_px / s
+    H, W = small.shape
+    x0, x1 = int(max(cx - 1.5 * d, 0)), int(min(cx + 1.5 * d + 1, W))
+    y0, y1 = int(max(cy - 1.5 * d, 0)), int(min(cy + 1.5 * d + 1, H))
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    rr = np.hypot(xx - cx, yy - cy)
+    vals = small[y0:y1, x0:x1][(rr >= d) & (rr <= 1.5 * d)]
+    return float(np.median(vals)) / 255.0 if vals.size else float(np.median(small)) / 255.0
+
+
 def _rim(cl, cr, reg_l, reg_r, small_l, small_r, depth_m) -> RimChoice:
     """Describe the edge used; ``surround`` is "ring" when outside the rim is not the surface."""
-    surf = (quantiles_u8(small_l, (0.5,))[0] / 255.0, quantiles_u8(small_r, (0.5,))[0] / 255.0)
+    surf = (_surface_level(small_l, cl), _surface_level(small_r, cr))
     rings = [
-        abs(r.outside_level - s) > 0.25 * abs(r.inside_level - s) + 0.03
+        max(abs(r.outside_level - s), abs(r.ring_level - s)) > 0.15 * abs(r.inside_level - s) + 0.02
         for r, s in zip((reg_l, reg_r), surf, strict=True)
     ]
     return RimChoice(
@@ -88,6 +103,7 @@ def _rim(cl, cr, reg_l, reg_r, small_l, small_r, depth_m) -> RimChoice:
         levels=(cl.levels, cr.levels),
         inside_level=(reg_l.inside_level, reg_r.inside_level),
         outside_level=(reg_l.outside_level, reg_r.outside_level),
+        ring_level=(reg_l.ring_level, reg_r.ring_level),
         surface_level=surf,
         depth_m=depth_m,
     )

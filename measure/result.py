@@ -85,8 +85,12 @@ class RimChoice:
             outer edge.
         diameter_px: equivalent diameter of the hole region (pixels).
         levels: how many of the detector's threshold-ladder levels gave this region.
-        inside_level, outside_level, surface_level: median gray levels (fraction of full
-            scale) just inside the rim, in a ring just outside it, and of the whole image.
+        inside_level, outside_level, ring_level, surface_level: median gray levels
+            (fraction of full scale) just inside the rim, in a ring just outside it (3 … 7
+            px), in a ring 5 … 20 % of the diameter outside it, and of the surface (an
+            annulus one to one and a half diameters from the centre). ``surround`` is
+            "ring" when the outside or ring level differs from the surface level by more
+            than 15 % of the rim's contrast plus 2 % of full scale, in both images.
         depth_m: depth of the region centroids (left frame, metres), from their disparity.
     """
 
@@ -96,6 +100,7 @@ class RimChoice:
     levels: tuple[int, int]
     inside_level: tuple[float, float]
     outside_level: tuple[float, float]
+    ring_level: tuple[float, float]
     surface_level: tuple[float, float]
     depth_m: float
 
@@ -120,6 +125,7 @@ class RimChoice:
             "levels": [int(v) for v in self.levels],
             "inside_level": [float(v) for v in self.inside_level],
             "outside_level": [float(v) for v in self.outside_level],
+            "ring_level": [float(v) for v in self.ring_level],
             "surface_level": [float(v) for v in self.surface_level],
             "depth_m": float(self.depth_m),
             "description": self.describe(),

@@ -263,7 +263,7 @@ def _camera_output(img: np.ndarray, opts: RenderOptions, win, rng) -> np.ndarray
     else:
         out = _finish(img, opts, win, rng)
     if opts.jpeg_quality is not None:
-        ok, buf = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, int(opts.jpeg_quality)])
+        _, buf = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, int(opts.jpeg_quality)])
         out = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
     return out
 
