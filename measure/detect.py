@@ -1,11 +1,25 @@
-"""Finding the hole in one image: exposure checks and disc-like region candidates.
+"""Finding the hole in one image: input checks and disc-like region candidates.
 
-The search runs on every 4th pixel of each row and column (well under a ms for 5 MP): a
-threshold a third of the way from the darkest pixels to the median (so a chamfer ring
-stays outside the hole), connected components of the
-dark (or, failing that, bright) class, and a disc test: an ellipse fitted to the region's
-outline must follow most of it closely. Regions cut by the border are kept and flagged, so
-the caller can say so instead of "no hole".
+The search runs on every 4th pixel of each row and column (a few ms for 5 MP) and is a
+*threshold ladder*: the dark class is thresholded at five levels between the darkest
+pixels and the median (25 % … 85 % of the way), each level's outer contours are tested
+for being disc-like (an ellipse fitted to the outline must follow most of it closely),
+and the discs found at several levels are grouped by position and size. Within a group
+the hole is the longest *plateau* — consecutive levels giving the same diameter within
+4 % — and of equal plateaus the darker one: a sharp rim gives the same region over a
+wide range of levels, while a chamfer ring, a shadow or a soft lip joins the region only
+at some levels. A small disc inside a larger one (a dark fragment of a screw or its
+shadow inside the bore) belongs to the larger one and is dropped. Discs that hold over
+two or more levels come first (a shadow or a stain next to the hole, or texture near the
+surface level, shows at one level only): dark ones, else bright ones (a through-hole
+against a lit background), and only if there are none, one-level discs. A dark disc
+inside a bright one is a bore inside a grommet when the two are concentric (the bright
+one goes), the bore wall's crescent beside a lit background when not (the dark one goes).
+Regions cut by the border are kept and flagged, so the caller can say so instead of
+"no hole".
+
+Images may be ``uint8`` or ``uint16`` holding 8 to 16 significant bits, single-channel or
+colour (converted to luma); see :func:`to_gray` and :func:`full_scale`.
 """
 
 from __future__ import annotations
@@ -19,6 +33,10 @@ from measure.errors import ImageError
 
 #: downsampling factor of the search image
 SEARCH_SCALE = 4
+#: fractions of the way from the darkest pixels to the median at which the ladder thresholds
+LADDER = (0.25, 0.4, 0.55, 0.7, 0.85)
+#: relative diameter change that still counts as "the same region" between ladder levels
+PLATEAU_TOLERANCE = 0.04
 
 
 @dataclass(frozen=True)
@@ -26,7 +44,8 @@ class HoleCandidate:
     """A disc-like region in full-resolution pixel coordinates.
 
     ``threshold`` separates hole from surface (gray level as a fraction of full scale),
-    ``polarity`` is ``"dark"`` (hole darker than the surface) or ``"bright"``.
+    ``polarity`` is ``"dark"`` (hole darker than the surface) or ``"bright"``;
+    ``levels`` is how many ladder levels gave this region (its plateau length).
     """
 
     centroid_px: tuple[float, float]
@@ -35,13 +54,41 @@ class HoleCandidate:
     polarity: str
     threshold: float
     touches_border: bool
+    levels: int = 1
+
+
+def to_gray(img: object, which: str) -> np.ndarray:
+    """The single-channel image ``measure_hole`` works on.
+
+    Accepts 2-D arrays and colour arrays ``(h, w, 3|4)`` (BGR or BGRA, as OpenCV reads
+    them; converted to luma) or ``(h, w, 1)``, of ``uint8`` or ``uint16``. Anything else
+    raises :class:`ImageError` naming what was given.
+    """
+    if not isinstance(img, np.ndarray):
+        raise ImageError(which, f"must be a numpy array, got {type(img).__name__}")
+    if img.dtype not in (np.uint8, np.uint16):
+        raise ImageError(which, f"must be uint8 or uint16, got {img.dtype}")
+    if img.ndim == 3 and img.shape[2] == 1:
+        img = img[:, :, 0]
+    elif img.ndim == 3 and img.shape[2] in (3, 4):
+        img = cv2.cvtColor(np.ascontiguousarray(img[:, :, :3]), cv2.COLOR_BGR2GRAY)
+    if img.ndim != 2:
+        raise ImageError(
+            which, f"must be single-channel (h, w) or colour (h, w, 3), got shape {img.shape}"
+        )
+    return img
 
 
 def full_scale(img: np.ndarray) -> float:
-    """Full-scale gray level: 255 for uint8; 4095 for 12-bit data in uint16, else 65535."""
+    """Full-scale gray level: 255 for uint8; for uint16 the smallest 2^k − 1 (k = 8, 10,
+    12, 14, 16) at or above the image maximum (sensors deliver 8 … 16 significant bits)."""
     if img.dtype == np.uint8:
         return 255.0
-    return 4095.0 if int(img.max()) <= 4095 else 65535.0
+    top = int(img.max())
+    for bits in (8, 10, 12, 14):
+        if top <= (1 << bits) - 1:
+            return float((1 << bits) - 1)
+    return 65535.0
 
 
 def quantiles_u8(img: np.ndarray, qs: tuple[float, ...]) -> list[float]:
@@ -53,7 +100,7 @@ def quantiles_u8(img: np.ndarray, qs: tuple[float, ...]) -> list[float]:
 
 def to_search_image(img: np.ndarray, full: float) -> np.ndarray:
     """Every 4th pixel in each direction, as uint8 (0.2 ms for 5 MP); the hole is a big blob."""
-    o = SEARCH_SCALE // 2
+    o = SEARCH_SCALE // 2 if min(img.shape) > SEARCH_SCALE * 8 else 0
     small = img[o::SEARCH_SCALE, o::SEARCH_SCALE]
     if small.dtype != np.uint8:
         small = np.clip(small.astype(np.float32) * (255.0 / full), 0, 255).astype(np.uint8)
@@ -61,30 +108,38 @@ def to_search_image(img: np.ndarray, full: float) -> np.ndarray:
 
 
 def check_image(img: np.ndarray, which: str) -> tuple[float, np.ndarray]:
-    """Reject unusable images (type, shape, saturated, black, flat).
+    """Reject unusable images (type, shape, size, saturated, black, flat).
 
-    Returns the full-scale gray level and the 8-bit search image (every 4th pixel).
+    ``img`` is the single-channel image of :func:`to_gray`. Returns the full-scale gray
+    level and the 8-bit search image (every 4th pixel). Messages give the figures that
+    decided.
     """
-    if not isinstance(img, np.ndarray) or img.ndim != 2:
-        shape = getattr(img, "shape", None)
-        raise ImageError(which, f"must be a single-channel 2-D array, got shape {shape}")
-    if img.dtype not in (np.uint8, np.uint16):
-        raise ImageError(which, f"must be uint8 or uint16, got {img.dtype}")
-    if min(img.shape) < 16:
-        raise ImageError(which, f"too small ({img.shape[1]}x{img.shape[0]} px)")
+    h, w = img.shape
+    if min(h, w) < 64:
+        raise ImageError(which, f"too small ({w}x{h} px; at least 64 px each side needed)")
     full = full_scale(img)
     small = to_search_image(img, full)
-    saturated = float(np.count_nonzero(small >= 254)) / small.size
-    if saturated > 0.5:
-        raise ImageError(which, f"saturated: {saturated:.0%} of the pixels are at full scale")
+    n = small.size
+    n_sat = int(np.count_nonzero(small >= 254))
+    if n_sat > 0.5 * n:
+        raise ImageError(
+            which,
+            f"saturated: {n_sat / n:.0%} of the pixels are at full scale "
+            f"({full:.0f}; at most 50 % allowed)",
+        )
     p1, p99 = quantiles_u8(small, (0.01, 0.99))
     if p99 < 0.04 * 255:
         raise ImageError(
-            which, f"black: 99 % of the pixels are below {p99 / 255:.1%} of full scale"
+            which,
+            f"black: 99 % of the pixels are at or below gray level "
+            f"{p99 / 255 * full:.0f} of {full:.0f} ({p99 / 255:.1%} of full scale; "
+            "the brightest 1 % must reach 4 %)",
         )
     if p99 - p1 < 0.05 * 255:
         raise ImageError(
-            which, f"no contrast: 98 % of the pixels lie within {(p99 - p1) / 255:.1%}"
+            which,
+            f"no contrast: 98 % of the pixels lie within {(p99 - p1) / 255:.1%} of full "
+            "scale (at least 5 % needed)",
         )
     return full, small
 
@@ -98,7 +153,7 @@ def _disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
     if len(pts) < 12:
         return False
     (cx, cy), (a2, b2), ang = cv2.fitEllipse(pts.astype(np.float32))
-    if min(a2, b2) <= 2 or min(a2, b2) / max(a2, b2) < 0.35:
+    if not np.isfinite(a2 + b2) or min(a2, b2) <= 2 or min(a2, b2) / max(a2, b2) < 0.35:
         return False
     t = np.deg2rad(ang)
     d = pts - (cx, cy)
@@ -109,15 +164,99 @@ def _disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
     return float(np.median(rel)) < tol / 2 and float(np.mean(rel < tol)) > 0.6
 
 
-def _masks(small: np.ndarray):
-    """(polarity, threshold 0..255, mask) for the dark class, then the bright class."""
+def _levels(small: np.ndarray):
+    """(polarity, [thresholds 0..255]) for the dark class, then the bright class."""
     p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
     if p_med - p_lo >= 0.2 * 255:
-        thr = p_lo + (p_med - p_lo) / 3.0
-        yield "dark", thr, small <= thr
+        yield "dark", [p_lo + f * (p_med - p_lo) for f in LADDER]
     if p_hi - p_med >= 0.2 * 255:
-        thr = p_hi - (p_hi - p_med) / 3.0
-        yield "bright", thr, small > thr
+        yield "bright", [p_hi - f * (p_hi - p_med) for f in LADDER]
+
+
+def _discs(mask: np.ndarray, min_area: float, level: int) -> list[tuple]:
+    """Disc-like outer regions of a mask: (cx, cy, area, bbox, border, level) in search px."""
+    H, W = mask.shape
+    contours, _ = cv2.findContours(mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    out = []
+    for c in contours:
+        if len(c) < 8:
+            continue
+        m = cv2.moments(c)
+        area = m["m00"]
+        if area < min_area or area > 0.5 * H * W:
+            continue
+        x, y, w, h = cv2.boundingRect(c)
+        border = x == 0 or y == 0 or x + w == W or y + h == H
+        if _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
+            out.append((m["m10"] / area, m["m01"] / area, area, (x, y, w, h), border, level))
+    return out
+
+
+def _plateau(members: list[tuple]) -> tuple:
+    """The member in the middle of the longest run of levels with the same diameter."""
+    members = sorted(members, key=lambda m: m[5])
+    runs: list[list[tuple]] = [[members[0]]]
+    for m in members[1:]:
+        prev = runs[-1][-1]
+        same = abs(np.sqrt(m[2] / prev[2]) - 1.0) <= PLATEAU_TOLERANCE and m[5] == prev[5] + 1
+        if same:
+            runs[-1].append(m)
+        else:
+            runs.append([m])
+    best = max(runs, key=len)  # max keeps the first (darkest) of equally long runs
+    return best[len(best) // 2] + (len(best),)
+
+
+def _group(discs: list[tuple]) -> list[tuple]:
+    """Group discs found at several levels into holes; drop discs inside a larger hole.
+
+    Returns (cx, cy, area, bbox, border, level, plateau length) per hole.
+    """
+    groups: list[list[tuple]] = []
+    for d in sorted(discs, key=lambda d: -d[2]):
+        r = np.sqrt(d[2] / np.pi)
+        for g in groups:
+            g0 = g[0]
+            r0 = np.sqrt(g0[2] / np.pi)
+            if np.hypot(d[0] - g0[0], d[1] - g0[1]) < 0.25 * r0 and r > 0.6 * r0:
+                g.append(d)
+                break
+        else:
+            groups.append([d])
+    picks = [_plateau(g) for g in groups]
+    return [
+        p
+        for p in picks
+        if not any(
+            q[2] > p[2] and np.hypot(p[0] - q[0], p[1] - q[1]) < np.sqrt(q[2] / np.pi)
+            for q in picks
+        )
+    ]
+
+
+def _cross_polarity(found: dict[str, tuple[list, list]]) -> None:
+    """Settle dark discs lying inside bright ones (in place).
+
+    Concentric (centres within 15 % of the bright radius): a dark bore inside a bright
+    grommet or washer — the bright disc goes. Off-centre: the dark crescent of the bore
+    wall beside a lit background seen through the hole — the dark disc goes.
+    """
+    if "dark" not in found or "bright" not in found:
+        return
+    dark, bright = found["dark"][1], found["bright"][1]
+    drop_dark, drop_bright = set(), set()
+    for i, d in enumerate(dark):
+        for j, b in enumerate(bright):
+            rb = np.sqrt(b[2] / np.pi)
+            off = np.hypot(d[0] - b[0], d[1] - b[1])
+            if d[2] >= b[2] or off >= rb:
+                continue
+            if off < 0.15 * rb:
+                drop_bright.add(j)
+            else:
+                drop_dark.add(i)
+    found["dark"][1][:] = [d for i, d in enumerate(dark) if i not in drop_dark]
+    found["bright"][1][:] = [b for j, b in enumerate(bright) if j not in drop_bright]
 
 
 def find_candidates(
@@ -135,39 +274,35 @@ def find_candidates(
     if roi is not None:
         x, y, w, h = (int(v) for v in roi)
         x0, y0 = max(x, 0) // s, max(y, 0) // s
-        small = small[y0 : (y + h) // s, x0 : (x + w) // s]
+        small = small[y0 : max((y + h) // s, y0), x0 : max((x + w) // s, x0)]
         ox, oy = x0 * s, y0 * s
-    H, W = small.shape
+        if min(small.shape) < 4:
+            return []
     min_area = np.pi * (0.5 * min_diameter_px / s) ** 2
-    for polarity, thr, mask in _masks(small):
-        contours, _ = cv2.findContours(
-            mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE
-        )
-        found: list[HoleCandidate] = []
-        for c in contours:
-            if len(c) < 8:
-                continue
-            m = cv2.moments(c)
-            area = m["m00"]
-            if area < min_area or area > 0.5 * H * W:
-                continue
-            x, y, w, h = cv2.boundingRect(c)
-            border = x == 0 or y == 0 or x + w == W or y + h == H
-            if not _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
-                continue
-            found.append(
-                HoleCandidate(
-                    centroid_px=(
-                        m["m10"] / area * s + s // 2 + ox,
-                        m["m01"] / area * s + s // 2 + oy,
-                    ),
-                    bbox=(x * s + ox, y * s + oy, w * s, h * s),
-                    diameter_px=float(2.0 * np.sqrt(area / np.pi) * s),
-                    polarity=polarity,
-                    threshold=float(thr) / 255.0,
-                    touches_border=border,
-                )
+    found = {}
+    for polarity, thresholds in _levels(small):
+        discs = []
+        for k, thr in enumerate(thresholds):
+            mask = (small <= thr) if polarity == "dark" else (small > thr)
+            discs += _discs(mask, min_area, k)
+        found[polarity] = (thresholds, _group(discs))
+    _cross_polarity(found)
+    # dark discs that hold over levels, else bright ones, else any dark, else any bright
+    order = [(p, t, [h for h in hs if h[6] >= 2]) for p, (t, hs) in found.items()]
+    order += [(p, t, hs) for p, (t, hs) in found.items()]
+    for polarity, thresholds, holes in order:
+        if not holes:
+            continue
+        return [
+            HoleCandidate(
+                centroid_px=(cx * s + s // 2 + ox, cy * s + s // 2 + oy),
+                bbox=(bx * s + ox, by * s + oy, bw * s, bh * s),
+                diameter_px=float(2.0 * np.sqrt(area / np.pi) * s),
+                polarity=polarity,
+                threshold=float(thresholds[level]) / 255.0,
+                touches_border=border,
+                levels=n_levels,
             )
-        if found:
-            return found
+            for cx, cy, area, (bx, by, bw, bh), border, level, n_levels in holes
+        ]
     return []

@@ -27,12 +27,22 @@ EDGE_METHODS = ("parabola", "linear")
 
 @dataclass(frozen=True)
 class HoleRegion:
-    """The hole region in a region of interest; coordinates are full-image pixels."""
+    """The hole region in a region of interest; coordinates are full-image pixels.
+
+    ``inside_level`` / ``outside_level`` are the median gray levels (fractions of full
+    scale) just inside the outline and in a ring just outside it; ``threshold`` the level
+    midway between them that drew the outline; ``ring_level`` the median in a wider ring
+    5 … 20 % of the diameter outside the outline (a grommet or washer shows there).
+    """
 
     roi: tuple[int, int, int, int]
     centroid_px: tuple[float, float]
     area_px: float
     mask: np.ndarray  # bool, ROI-sized
+    threshold: float = 0.0
+    inside_level: float = 0.0
+    outside_level: float = 0.0
+    ring_level: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -50,37 +60,92 @@ class EdgePoints:
     width_px: np.ndarray | None = None
 
 
+def _median(img: np.ndarray, mask: np.ndarray, full: float) -> float | None:
+    """Median gray level (fraction of full scale) of the masked pixels, from a histogram."""
+    if not mask.any():
+        return None
+    bins = 256 if img.dtype == np.uint8 else 1024
+    hist = cv2.calcHist([img], [0], mask.view(np.uint8), [bins], [0, full + 1]).ravel()
+    cdf = np.cumsum(hist)
+    k = int(np.searchsorted(cdf, 0.5 * cdf[-1]))
+    return (k + 0.5) * (full + 1) / bins / full
+
+
+def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
+    """The filled outer outline of the mask component around ``seed`` (ROI pixels)."""
+    contours, _ = cv2.findContours(mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    inside = [c for c in contours if cv2.pointPolygonTest(c, seed, False) >= 0]
+    pool = inside or list(contours)
+    region = np.zeros(mask.shape, np.uint8)
+    if pool:  # the outer outline, filled: islands inside the hole (a screw) do not matter
+        cv2.drawContours(region, [max(pool, key=cv2.contourArea)], -1, 1, thickness=cv2.FILLED)
+    return region
+
+
+def _ring(region: np.ndarray, inner: int, outer: int) -> np.ndarray:
+    k_in = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * inner + 1, 2 * inner + 1))
+    k_out = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * outer + 1, 2 * outer + 1))
+    return (cv2.dilate(region, k_out) > 0) & ~(cv2.dilate(region, k_in) > 0)
+
+
 def hole_region(
     img: np.ndarray, full: float, cand: HoleCandidate, margin_px: int = 10
 ) -> HoleRegion:
-    """Crop around the candidate and find its region at full resolution; centroid by moments."""
+    """Crop around the candidate and find its region at full resolution; centroid by moments.
+
+    The candidate's threshold gives a first outline; the gray levels just inside it and
+    in a ring 3 … 3 + max(4, 3 % of the diameter) px outside it set a local threshold
+    midway between the two, which draws the final outline. So the outline follows the
+    rim where the light is uneven, and lies on the middle of a soft edge. For a bright
+    interior (a through-hole against a lit background) pixels as far *below* the
+    surrounding level are part of the hole too: the bore wall, seen at a tilt as a dark
+    crescent between the background and the rim.
+    """
     H, W = img.shape
     x, y, w, h = cand.bbox
     m = margin_px + int(0.12 * max(w, h))
     x0, y0 = max(x - m, 0), max(y - m, 0)
     x1, y1 = min(x + w + m, W), min(y + h + m, H)
-    roi_img = img[y0:y1, x0:x1]
-    level = cand.threshold * full
-    mask = (roi_img <= level) if cand.polarity == "dark" else (roi_img > level)
-    contours, _ = cv2.findContours(
-        mask.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE
-    )
+    roi_img = np.ascontiguousarray(img[y0:y1, x0:x1])
     cx, cy = cand.centroid_px
+    seed = (float(cx - x0), float(cy - y0))
     box = (x0, y0, x1 - x0, y1 - y0)
-    inside = [
-        c for c in contours if cv2.pointPolygonTest(c, (float(cx - x0), float(cy - y0)), False) >= 0
-    ]
-    pool = inside or list(contours)
-    region = np.zeros(mask.shape, np.uint8)
-    if not pool:
-        return HoleRegion(box, (cx, cy), 0.0, region > 0)
-    # the outer outline, filled: islands inside the hole (a highlight) do not matter
-    cv2.drawContours(region, [max(pool, key=cv2.contourArea)], -1, 1, thickness=cv2.FILLED)
+    dark = cand.polarity == "dark"
+    level = cand.threshold
+    region = _region((roi_img <= level * full) if dark else (roi_img > level * full), seed)
+    inside = outside = level
+    if region.any():
+        k = max(4, int(0.03 * cand.diameter_px))
+        ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
+        core = cv2.erode(region, ker) > 0
+        lin, lout = _median(roi_img, core, full), _median(roi_img, _ring(region, 3, 3 + k), full)
+        if lin is not None and lout is not None and (lin < lout) == dark:
+            inside, outside = lin, lout
+            level = 0.5 * (lin + lout)
+            if dark:
+                mask = roi_img <= level * full
+            else:  # a lit background: the bore wall seen at a tilt is a dark crescent
+                mask = (roi_img > level * full) | (roi_img < (2 * lout - level) * full)
+            refined = _region(mask, seed)
+            ratio = float(refined.sum()) / float(region.sum())
+            if 0.6 < ratio < 1.6:  # the same region, better placed; else keep the first
+                region = refined
     mom = cv2.moments(region, binaryImage=True)
     if mom["m00"] <= 0:
-        return HoleRegion(box, (cx, cy), 0.0, region > 0)
+        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
     centroid = (mom["m10"] / mom["m00"] + x0, mom["m01"] / mom["m00"] + y0)
-    return HoleRegion(box, centroid, float(mom["m00"]), region > 0)
+    d = 2.0 * np.sqrt(mom["m00"] / np.pi)
+    wide = _median(roi_img, _ring(region, int(0.05 * d) + 1, int(0.2 * d) + 2), full)
+    return HoleRegion(
+        box,
+        centroid,
+        float(mom["m00"]),
+        region > 0,
+        level,
+        inside,
+        outside,
+        outside if wide is None else wide,
+    )
 
 
 def outline_band(region: np.ndarray, half_width: int) -> np.ndarray:

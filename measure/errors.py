@@ -117,3 +117,23 @@ class CalibrationTargetError(MeasurementError):
         self.rejected = rejected
         lines = [reason] + [f"  {name}: {why}" for name, why in rejected]
         super().__init__("\n".join(lines))
+
+
+class StereoMismatchError(MeasurementError):
+    """Hole candidates were found in both images, but no left/right pair is one hole.
+
+    ``counts`` maps each failed check (``"epipolar"``, ``"size"``, ``"depth"``,
+    ``"expected size"``) to the number of candidate pairs it ruled out; ``detail`` names the
+    closest pair's figures.
+    """
+
+    def __init__(self, n_left: int, n_right: int, counts: dict[str, int], detail: str) -> None:
+        self.n_left = n_left
+        self.n_right = n_right
+        self.counts = counts
+        self.detail = detail
+        why = ", ".join(f"{n} by {k}" for k, n in counts.items() if n)
+        super().__init__(
+            f"left and right images do not show the same hole: {n_left} left × {n_right} "
+            f"right candidates, every pair ruled out ({why}); {detail}"
+        )

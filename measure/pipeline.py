@@ -15,10 +15,9 @@ import numpy as np
 from measure.calibration import StereoCalibration
 from measure.circle import fit_circle_3d
 from measure.contour import Contour, build_contour
-from measure.detect import HoleCandidate, check_image, find_candidates
-from measure.edges import hole_region, subpixel_edges
+from measure.detect import SEARCH_SCALE, HoleCandidate, check_image, find_candidates, to_gray
+from measure.edges import HoleRegion, hole_region, subpixel_edges
 from measure.errors import (
-    AmbiguousHoleError,
     EdgeError,
     HoleAtBorderError,
     HoleNotFoundError,
@@ -27,7 +26,8 @@ from measure.errors import (
 )
 from measure.match import match_contours
 from measure.nearside import fit_with_near_side_check
-from measure.result import HoleMeasurement, MeasureOptions
+from measure.pairing import pick_pair
+from measure.result import HoleMeasurement, MeasureOptions, RimChoice
 from measure.triangulate import triangulate
 
 Rect = tuple[int, int, int, int]
@@ -56,40 +56,7 @@ def _usable(cands: list[HoleCandidate], which: str, roi: Rect | None, shape) -> 
     )
 
 
-def _pick_pair(
-    left: list[HoleCandidate],
-    right: list[HoleCandidate],
-    stereo: StereoCalibration,
-    expected_m: float | None,
-    tol: float,
-) -> tuple[HoleCandidate, HoleCandidate]:
-    """One candidate per image: the unique one, or the stereo pair nearest the expected size."""
-    if len(left) == 1 and len(right) == 1:
-        return left[0], right[0]
-    if expected_m is None:
-        which, cands = ("left", left) if len(left) > 1 else ("right", right)
-        raise AmbiguousHoleError(which, [(*c.centroid_px, c.diameter_px) for c in cands])
-    cl = stereo.undistort_rectify(np.array([c.centroid_px for c in left]), "left")
-    cr = stereo.undistort_rectify(np.array([c.centroid_px for c in right]), "right")
-    f = stereo.rectification.P1[0, 0]
-    scored = []
-    for i, a in enumerate(left):
-        for j, b in enumerate(right):
-            if abs(cl[i, 1] - cr[j, 1]) > max(6.0, 0.1 * a.diameter_px):
-                continue  # not on the same epipolar line
-            if abs(a.diameter_px - b.diameter_px) > 0.25 * max(a.diameter_px, b.diameter_px):
-                continue  # two views of one hole have about the same size
-            X = triangulate(stereo, cl[i : i + 1], cr[j : j + 1], optimal=False)[0]
-            d_m = 0.5 * (a.diameter_px + b.diameter_px) * X[2] / f
-            scored.append((abs(d_m / expected_m - 1.0), i, j))
-    good = sorted(s for s in scored if s[0] <= 2 * tol)
-    if len(good) == 1 or (len(good) > 1 and good[1][0] > 2 * good[0][0] + 0.1):
-        return left[good[0][1]], right[good[0][2]]
-    which, cands = ("left", left) if len(left) > 1 else ("right", right)
-    raise AmbiguousHoleError(which, [(*c.centroid_px, c.diameter_px) for c in cands])
-
-
-def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour, Rect, float]:
+def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour, HoleRegion]:
     region = hole_region(img, full, cand)
     edges = subpixel_edges(img, full, region, opts.edge_method, opts.smoothing_sigma_px)
     pts = edges.points_px
@@ -98,8 +65,79 @@ def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour
         pts, region.centroid_px, opts.arc_step_px, opts.short_gap_px, blur_sigma_px=blur
     )
     if contour is None:
-        raise EdgeError(f"{which} image edges", len(edges.points_px), 12)
-    return contour, region.roi, float(region.area_px)
+        raise EdgeError(
+            f"{which} image edges (hole region ⌀{cand.diameter_px:.0f} px at "
+            f"({cand.centroid_px[0]:.0f}, {cand.centroid_px[1]:.0f}))",
+            len(edges.points_px),
+            12,
+        )
+    return contour, region
+
+
+def _surface_level(small: np.ndarray, cand: HoleCandidate) -> float:
+    """Median of the search image in an annulus 1.0 … 1.5 diameters from the hole's centre:
+    the part's surface beyond any grommet or washer (fraction of full scale)."""
+    s = SEARCH_SCALE
+    cx, cy = (cand.centroid_px[0] - s // 2) / s, (cand.centroid_px[1] - s // 2) / s
+    d = cand.diameter_px / s
+    H, W = small.shape
+    x0, x1 = int(max(cx - 1.5 * d, 0)), int(min(cx + 1.5 * d + 1, W))
+    y0, y1 = int(max(cy - 1.5 * d, 0)), int(min(cy + 1.5 * d + 1, H))
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    rr = np.hypot(xx - cx, yy - cy)
+    vals = small[y0:y1, x0:x1][(rr >= d) & (rr <= 1.5 * d)]
+    return float(np.median(vals)) / 255.0 if vals.size else float(np.median(small)) / 255.0
+
+
+def _rim(cl, cr, reg_l, reg_r, small_l, small_r, depth_m) -> RimChoice:
+    """Describe the edge used; ``surround`` is "ring" when outside the rim is not the surface."""
+    surf = (_surface_level(small_l, cl), _surface_level(small_r, cr))
+    rings = [
+        max(abs(r.outside_level - s), abs(r.ring_level - s)) > 0.15 * abs(r.inside_level - s) + 0.02
+        for r, s in zip((reg_l, reg_r), surf, strict=True)
+    ]
+    return RimChoice(
+        polarity=cl.polarity,
+        surround="ring" if all(rings) else "surface",
+        diameter_px=(2 * np.sqrt(reg_l.area_px / np.pi), 2 * np.sqrt(reg_r.area_px / np.pi)),
+        levels=(cl.levels, cr.levels),
+        inside_level=(reg_l.inside_level, reg_r.inside_level),
+        outside_level=(reg_l.outside_level, reg_r.outside_level),
+        ring_level=(reg_l.ring_level, reg_r.ring_level),
+        surface_level=surf,
+        depth_m=depth_m,
+    )
+
+
+def _suspect_reasons(
+    opts: MeasureOptions, bad: int, n_contour: int, rms_m: float, px_m: float, rim: RimChoice
+) -> tuple[str, ...]:
+    """Why a measurement is suspect (thresholds: :class:`MeasureOptions`)."""
+    out = []
+    if bad > opts.suspect_fraction * n_contour:
+        out.append(
+            f"{bad} of {n_contour} contour samples filled or rejected "
+            f"(more than {opts.suspect_fraction:.0%})"
+        )
+    rms_limit = max(opts.suspect_rms_m, opts.suspect_rms_px * px_m)
+    if rms_m > rms_limit:
+        out.append(
+            f"fit RMS {rms_m * 1e6:.1f} µm ({rms_m / px_m:.2f} px) above "
+            f"{rms_limit * 1e6:.1f} µm (max of {opts.suspect_rms_m * 1e6:.0f} µm and "
+            f"{opts.suspect_rms_px:g} px)"
+        )
+    contrast = [abs(o - i) for i, o in zip(rim.inside_level, rim.outside_level, strict=True)]
+    diff = max(
+        abs(rim.inside_level[0] - rim.inside_level[1]),
+        abs(rim.outside_level[0] - rim.outside_level[1]),
+    )
+    if diff > opts.suspect_rim_mismatch * max(min(contrast), 1e-6):
+        out.append(
+            f"left and right rims differ: gray levels inside/outside "
+            f"{rim.inside_level[0]:.2f}/{rim.outside_level[0]:.2f} vs "
+            f"{rim.inside_level[1]:.2f}/{rim.outside_level[1]:.2f}"
+        )
+    return tuple(out)
 
 
 def _weights(c: Contour, opts: MeasureOptions) -> np.ndarray:
@@ -116,12 +154,14 @@ def measure_hole(
     expected_diameter_m: float | None = None,
     roi=None,
     options: MeasureOptions | None = None,
+    expected_standoff_m: float | None = None,
 ) -> HoleMeasurement:
     """Measure one hole from a stereo pair.
 
     Args:
-        left, right: single-channel ``uint8`` or ``uint16`` (12- or 16-bit) images, as
-            the cameras deliver them (distorted), of the calibrated size.
+        left, right: ``uint8`` or ``uint16`` (8 … 16 significant bits) images, as the
+            cameras deliver them (distorted), of the calibrated size; single-channel or
+            colour ``(h, w, 3)`` BGR (converted to luma).
         stereo: the head's calibration.
         expected_diameter_m: nominal diameter; picks the hole when several are in view
             and raises :class:`HoleSizeError` when the result is off by more than
@@ -129,6 +169,8 @@ def measure_hole(
         roi: ``(x, y, w, h)`` for both images, or ``((x, y, w, h), (x, y, w, h))`` for left
             and right, to restrict the search.
         options: :class:`MeasureOptions`.
+        expected_standoff_m: nominal depth of the hole (metres, left frame); candidate
+            pairs whose disparity puts them outside half to twice this depth are ruled out.
 
     Returns:
         :class:`HoleMeasurement` in the LEFT camera optical frame (metres).
@@ -139,20 +181,24 @@ def measure_hole(
     opts = options or MeasureOptions()
     t = {}
     t0 = time.perf_counter()
-    if np.shape(left) != np.shape(right):
-        raise ImageError("pair", f"left is {np.shape(left)} but right is {np.shape(right)} (h, w)")
+    left, right = to_gray(left, "left"), to_gray(right, "right")
+    if left.shape != right.shape:
+        raise ImageError("pair", f"left is {left.shape} but right is {right.shape} (h, w)")
     full_l, small_l = check_image(left, "left")
     full_r, small_r = check_image(right, "right")
     stereo.check_image(left.shape, "left")
     roi_l, roi_r = _rois(roi)
     cand_l = _usable(find_candidates(small_l, roi_l), "left", roi_l, left.shape)
     cand_r = _usable(find_candidates(small_r, roi_r), "right", roi_r, right.shape)
-    cl, cr = _pick_pair(cand_l, cand_r, stereo, expected_diameter_m, opts.size_tolerance)
+    cl, cr, check = pick_pair(
+        cand_l, cand_r, stereo, expected_diameter_m, opts.size_tolerance, expected_standoff_m
+    )
     t["detect"] = time.perf_counter() - t0
 
     t1 = time.perf_counter()
-    con_l, box_l, _ = _contour(left, full_l, cl, opts, "left")
-    con_r, box_r, _ = _contour(right, full_r, cr, opts, "right")
+    con_l, reg_l = _contour(left, full_l, cl, opts, "left")
+    con_r, reg_r = _contour(right, full_r, cr, opts, "right")
+    rim = _rim(cl, cr, reg_l, reg_r, small_l, small_r, check.depth_m)
     t["edges"] = time.perf_counter() - t1
 
     t2 = time.perf_counter()
@@ -188,7 +234,9 @@ def measure_hole(
     n_filled = int(con_l.filled.sum() + con_r.filled.sum())
     n_contour = len(con_l.points_px) + len(con_r.points_px)
     bad = n_filled + con_l.n_outliers + con_r.n_outliers + circ.n_rejected
-    status = "suspect" if bad > opts.suspect_fraction * n_contour else "ok"
+    px_m = float(circ.center[2]) / float(stereo.K_left[0, 0])  # one pixel at the hole, m
+    reasons = _suspect_reasons(opts, bad, n_contour, circ.rms_m, px_m, rim)
+    status = "suspect" if reasons else "ok"
     total = time.perf_counter() - t0
     return HoleMeasurement(
         status=status,
@@ -210,7 +258,9 @@ def measure_hole(
         ellipse_right=con_r.ellipse,
         points_m=pts,
         inliers=circ.inliers,
-        roi_left=box_l,
-        roi_right=box_r,
+        roi_left=reg_l.roi,
+        roi_right=reg_r.roi,
         options=opts,
+        rim=rim,
+        suspect_reasons=reasons,
     )

@@ -34,6 +34,13 @@ class MeasureOptions:
         size_tolerance: relative diameter deviation from ``expected_diameter_m`` that is an error.
         suspect_fraction: status ``"suspect"`` when more than this fraction of the contour
             was filled or rejected.
+        suspect_rms_m, suspect_rms_px: status ``"suspect"`` when the fit's RMS residual
+            exceeds both ``suspect_rms_m`` (metres) and ``suspect_rms_px`` left-camera pixels
+            at the hole's depth (a good fit is a few µm on the standard head, about 0.05 px;
+            a fit through the wrong edge or a broken contour is tenths of a pixel).
+        suspect_rim_mismatch: status ``"suspect"`` when the left and right edges used were
+            found at gray levels (inside, outside) that differ by more than this fraction
+            of the contrast: the two images may show different edges.
     """
 
     edge_method: str = "parabola"
@@ -48,6 +55,9 @@ class MeasureOptions:
     near_side_max_angle_deg: float | None = 25.0
     size_tolerance: float = 0.2
     suspect_fraction: float = 0.3
+    suspect_rms_m: float = 25e-6
+    suspect_rms_px: float = 0.3
+    suspect_rim_mismatch: float = 0.5
 
     @classmethod
     def published(cls) -> MeasureOptions:
@@ -63,11 +73,73 @@ class MeasureOptions:
 
 
 @dataclass(frozen=True)
+class RimChoice:
+    """Which edge was measured as the hole's rim (per image: left, right).
+
+    Attributes:
+        polarity: ``"dark"`` (the hole interior is darker than what surrounds it) or
+            ``"bright"`` (a through-hole against a lit background).
+        surround: ``"surface"`` when just outside the rim is the part's surface, ``"ring"``
+            when it is a ring of another brightness (a grommet, washer, lip or chamfer):
+            the measured edge is then the bore's rim inside that ring, not the ring's
+            outer edge.
+        diameter_px: equivalent diameter of the hole region (pixels).
+        levels: how many of the detector's threshold-ladder levels gave this region.
+        inside_level, outside_level, ring_level, surface_level: median gray levels
+            (fraction of full scale) just inside the rim, in a ring just outside it (3 … 7
+            px), in a ring 5 … 20 % of the diameter outside it, and of the surface (an
+            annulus one to one and a half diameters from the centre). ``surround`` is
+            "ring" when the outside or ring level differs from the surface level by more
+            than 15 % of the rim's contrast plus 2 % of full scale, in both images.
+        depth_m: depth of the region centroids (left frame, metres), from their disparity.
+    """
+
+    polarity: str
+    surround: str
+    diameter_px: tuple[float, float]
+    levels: tuple[int, int]
+    inside_level: tuple[float, float]
+    outside_level: tuple[float, float]
+    ring_level: tuple[float, float]
+    surface_level: tuple[float, float]
+    depth_m: float
+
+    def describe(self) -> str:
+        """One line for people: which edge was used."""
+        where = (
+            "inside a ring of another brightness (grommet, washer, lip or chamfer)"
+            if self.surround == "ring"
+            else "against the surface"
+        )
+        return (
+            f"rim of the {self.polarity} interior {where}, ⌀{self.diameter_px[0]:.0f} / "
+            f"{self.diameter_px[1]:.0f} px (left / right)"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form."""
+        return {
+            "polarity": self.polarity,
+            "surround": self.surround,
+            "diameter_px": [float(v) for v in self.diameter_px],
+            "levels": [int(v) for v in self.levels],
+            "inside_level": [float(v) for v in self.inside_level],
+            "outside_level": [float(v) for v in self.outside_level],
+            "ring_level": [float(v) for v in self.ring_level],
+            "surface_level": [float(v) for v in self.surface_level],
+            "depth_m": float(self.depth_m),
+            "description": self.describe(),
+        }
+
+
+@dataclass(frozen=True)
 class HoleMeasurement:
     """A measured hole, in the LEFT camera optical frame, SI units.
 
     Attributes:
-        status: ``"ok"``, or ``"suspect"`` when much of the edge was filled or rejected.
+        status: ``"ok"``, or ``"suspect"`` when much of the edge was filled or rejected,
+            the fit RMS is high, or the two images' rims differ (``suspect_reasons`` says
+            which; thresholds in :class:`MeasureOptions`).
         center_m: circle centre (3,). normal: unit axis pointing toward the camera (3,).
         radius_m: circle radius. rms_m: RMS orthogonal residual of the fitted 3-D points.
         n_points / n_rejected / n_filled: 3-D points used by the fit, rejected as outliers,
@@ -80,6 +152,8 @@ class HoleMeasurement:
             ``((cx, cy), (axis1, axis2), angle_deg)`` with full axis lengths.
         points_m: triangulated edge points (K, 3, left frame); ``inliers`` (K,) those kept.
         roi_left / roi_right: the regions of interest used, ``(x, y, w, h)``.
+        rim: which edge was measured (:class:`RimChoice`); ``suspect_reasons`` why the
+            status is ``"suspect"`` (empty when ``"ok"``).
     """
 
     status: str
@@ -104,6 +178,8 @@ class HoleMeasurement:
     roi_left: tuple[int, int, int, int]
     roi_right: tuple[int, int, int, int]
     options: MeasureOptions = field(default_factory=MeasureOptions)
+    rim: RimChoice | None = None
+    suspect_reasons: tuple[str, ...] = ()
 
     @property
     def diameter_m(self) -> float:
@@ -122,6 +198,9 @@ class HoleMeasurement:
             "n_points": int(self.n_points),
             "n_rejected": int(self.n_rejected),
             "n_filled": int(self.n_filled),
+            "rms_um": float(self.rms_m * 1e6),
+            "suspect_reasons": list(self.suspect_reasons),
+            "rim": self.rim.to_dict() if self.rim is not None else None,
             "cov_center_radius_m2": self.cov_center_radius.tolist(),
             "time_s": float(self.time_s),
             "timings_s": {k: float(v) for k, v in self.timings.items()},

@@ -4,7 +4,11 @@ Geometry in the hole's local frame: z along the hole normal (out of the material
 the camera), the surface is the plane z = 0, the bore is the cylinder ρ = r for
 -depth ≤ z ≤ -chamfer, the 45° chamfer is the cone ρ = r + chamfer + z for -chamfer ≤ z ≤ 0.
 A burr (occluder) is a flat flap on the surface covering the rim over an azimuth range;
-a specular highlight is a bright streak across the rim. Values are fractions of full scale
+a specular highlight is a bright streak across the rim. Optionally the chamfer is shaded
+as a rounded lip (brightness falling from the surface level to dark as its normal turns
+from the view toward the bore, a soft edge), the wall is lit from one side (directional
+light, the other side in shadow) and a bright disc with radial marks (a screw head) sits
+inside the bore. Values are fractions of full scale
 before vignetting.
 """
 
@@ -32,6 +36,12 @@ class Shading:
     occlusion_fraction: float
     occlusion_azimuth: float
     texture_offset: tuple[float, float]
+    light_azimuth: float = 0.0  # direction (in the hole plane) the light comes from
+    wall_light: float = 0.0  # wall brightness modulation with azimuth (0: even)
+    object_radius: float = 0.0  # a disc (screw head) inside the bore, radius (m; 0: none)
+    object_depth: float = 0.0  # its depth below the surface (m)
+    object_level: float = 0.0  # its brightness
+    lip_rounded: bool = False  # the chamfer cone is shaded as a rounded lip
 
 
 @dataclass(frozen=True)
@@ -140,9 +150,12 @@ def shade(geo: HoleGeometry, sh: Shading, nx: np.ndarray, ny: np.ndarray) -> np.
         hit = np.isfinite(best)
         hx, hy = ox + best[hit] * dx[hit], oy + best[hit] * dy[hit]
         az = np.arctan2(hy, hx)
-        val[hit] = sh.chamfer * (1.0 + 0.15 * np.cos(az - 0.8)) * _surface_texture(
-            hx, hy, sh
-        ) + 0.6 * _highlight(hx, hy, r, sh)
+        if sh.lip_rounded:  # quarter round of radius ch, Lambert under light along the axis:
+            frac = np.clip((r + ch - np.hypot(hx, hy)) / ch, 0.0, 1.0)  # sin(normal angle)
+            level = sh.surface * np.sqrt(1.0 - frac * frac) + sh.wall * frac
+        else:
+            level = sh.chamfer * (1.0 + 0.15 * np.cos(az - 0.8))
+        val[hit] = level * _surface_texture(hx, hy, sh) + 0.6 * _highlight(hx, hy, r, sh)
         done |= hit
     a = dx * dx + dy * dy
     b = 2.0 * (ox * dx + oy * dy)
@@ -153,8 +166,16 @@ def shade(geo: HoleGeometry, sh: Shading, nx: np.ndarray, ny: np.ndarray) -> np.
     wall = ~done & np.isfinite(t_exit) & (zw >= -geo.depth) & (zw <= -ch + 1e-12)
     frac = np.clip(-zw[wall] / geo.depth, 0.0, 1.0)
     hx, hy = ox + t_exit[wall] * dx[wall], oy + t_exit[wall] * dy[wall]
-    val[wall] = sh.wall * (1.0 - 0.7 * frac) + 0.5 * _highlight(hx, hy, r, sh) * np.exp(
+    lit = 1.0 + sh.wall_light * np.cos(np.arctan2(hy, hx) - sh.light_azimuth - np.pi)
+    val[wall] = sh.wall * lit * (1.0 - 0.7 * frac) + 0.5 * _highlight(hx, hy, r, sh) * np.exp(
         zw[wall] / (0.15 * r)
     )
+    if sh.object_radius > 0:  # a screw head: a disc at object_depth, in front of the rest
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_obj = (-sh.object_depth - oz) / dz
+        px_, py_ = ox + t_obj * dx, oy + t_obj * dy
+        on = ~done & (np.hypot(px_, py_) < sh.object_radius) & (t_obj > ti)
+        marks = 0.5 + 0.5 * np.cos(4.0 * np.arctan2(py_[on], px_[on]))
+        val[on] = sh.object_level * (0.6 + 0.4 * marks)
     out[inside] = val
     return out

@@ -39,6 +39,19 @@ class RenderOptions:
         hole_depth_m: bore depth (metres); ``None``: one diameter.
         highlight: peak brightness of a specular streak across the rim (0: none).
         occlusion_fraction: fraction of the rim circumference hidden by a burr flap (0..0.5).
+
+    Realism (the "realistic" benchmark group; defaults leave the standard scene as is):
+        lip_rounded: shade the ``chamfer_m`` cone as a rounded lip (soft edge; the truth is
+            still the bore edge one ``chamfer_m`` below the surface).
+        wall_light: directional light on the bore wall: brightness ×(1 ± wall_light) with
+            azimuth, the side facing the light bright, the other in shadow.
+        light_gradient: uneven light across the image: brightness ×(1 ± light_gradient)
+            from one image edge to the other, direction seeded.
+        object_fraction: a screw head inside the bore, a bright disc of this fraction of
+            the bore radius, half a bore depth down (0: none); ``object_level`` its brightness.
+        bayer: render through a BGGR colour filter (``colour_gains`` B, G, R) with noise on
+            the mosaic and OpenCV's demosaicing; the images are then colour ``(h, w, 3)``.
+        jpeg_quality: JPEG-compress the result (8-bit only; ``None``: none).
     """
 
     bit_depth: int = 8
@@ -56,6 +69,14 @@ class RenderOptions:
     hole_depth_m: float | None = None
     highlight: float = 0.0
     occlusion_fraction: float = 0.0
+    lip_rounded: bool = False
+    wall_light: float = 0.0
+    light_gradient: float = 0.0
+    object_fraction: float = 0.0
+    object_level: float = 0.7
+    bayer: bool = False
+    colour_gains: tuple[float, float, float] = (0.75, 1.0, 0.85)
+    jpeg_quality: int | None = None
 
 
 @dataclass(frozen=True)
@@ -81,7 +102,8 @@ class HoleTruth:
 
 @dataclass(frozen=True)
 class StereoRender:
-    """A rendered pair (``uint8`` or ``uint16`` images, shape (h, w)) and its truth."""
+    """A rendered pair (``uint8`` or ``uint16`` images, shape (h, w), or (h, w, 3) BGR
+    with ``bayer``) and its truth."""
 
     left: np.ndarray
     right: np.ndarray
@@ -217,6 +239,35 @@ def _finish(img: np.ndarray, opts: RenderOptions, win, rng: np.random.Generator)
     return (dn + np.float32(0.5)).astype(np.uint16)
 
 
+def _uneven(img: np.ndarray, strength: float, angle: float) -> None:
+    """Multiply in place by a linear light ramp 1 ± ``strength`` across the image."""
+    h, w = img.shape
+    u = (np.arange(w, dtype=np.float32) - 0.5 * w) / (0.5 * w) * np.float32(math.cos(angle))
+    v = (np.arange(h, dtype=np.float32) - 0.5 * h) / (0.5 * h) * np.float32(math.sin(angle))
+    img *= 1.0 + np.float32(strength) * (v[:, None] + u[None, :])
+
+
+def _mosaic(img: np.ndarray, gains: tuple[float, float, float]) -> np.ndarray:
+    """A BGGR Bayer mosaic of a gray scene seen through colour gains (B, G, R)."""
+    out = img * np.float32(gains[1])
+    out[0::2, 0::2] = img[0::2, 0::2] * np.float32(gains[0])  # B
+    out[1::2, 1::2] = img[1::2, 1::2] * np.float32(gains[2])  # R
+    return out
+
+
+def _camera_output(img: np.ndarray, opts: RenderOptions, win, rng) -> np.ndarray:
+    """Noise and quantisation, then the optional demosaicing and JPEG compression."""
+    if opts.bayer:
+        raw = _finish(_mosaic(img, opts.colour_gains), opts, win, rng)
+        out = cv2.cvtColor(raw, cv2.COLOR_BayerBG2BGR)
+    else:
+        out = _finish(img, opts, win, rng)
+    if opts.jpeg_quality is not None:
+        _, buf = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, int(opts.jpeg_quality)])
+        out = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+    return out
+
+
 def _render_side(stereo, side, geo, sh, opts, rng) -> tuple[np.ndarray, tuple[int, int, int, int]]:
     img = _background(stereo, side, geo, sh, opts.vignetting)
     r_win = (1.75 if opts.highlight > 0 else 1.2) * geo.radius + 2.0 * geo.chamfer + 1e-3
@@ -227,7 +278,24 @@ def _render_side(stereo, side, geo, sh, opts, rng) -> tuple[np.ndarray, tuple[in
         big = (x0 - margin, y0 - margin, w + 2 * margin, h + 2 * margin)
         patch = _render_window(stereo, side, geo, sh, opts, big)
         img[y0 : y0 + h, x0 : x0 + w] = patch[margin : margin + h, margin : margin + w]
-    return _finish(img, opts, win, rng), win
+    if opts.light_gradient:
+        _uneven(img, opts.light_gradient, sh.light_azimuth)
+    return _camera_output(img, opts, win, rng), win
+
+
+def _realism(opts: RenderOptions, r: float, depth: float, rng: np.random.Generator) -> dict:
+    """Shading fields of the realism options (no random draws when all are off, so the
+    standard scene's images stay the same for the same seed)."""
+    if not (opts.wall_light or opts.light_gradient or opts.object_fraction or opts.lip_rounded):
+        return {}
+    return {
+        "light_azimuth": float(rng.uniform(0, 2 * np.pi)),
+        "wall_light": opts.wall_light,
+        "object_radius": opts.object_fraction * r,
+        "object_depth": 0.5 * depth,
+        "object_level": opts.object_level,
+        "lip_rounded": opts.lip_rounded,
+    }
 
 
 def render_hole_pair(
@@ -255,6 +323,8 @@ def render_hole_pair(
     opts = options or RenderOptions()
     if opts.bit_depth not in (8, 12):
         raise ValueError(f"bit_depth must be 8 or 12, got {opts.bit_depth}")
+    if opts.jpeg_quality is not None and opts.bit_depth != 8:
+        raise ValueError("jpeg_quality needs bit_depth 8")
     c = np.asarray(center_m, dtype=float).reshape(3)
     n = np.asarray(normal, dtype=float).reshape(3)
     n = n / np.linalg.norm(n)
@@ -282,6 +352,7 @@ def render_hole_pair(
             TILE_CENTER_M + float(rng.uniform(-5e-3, 5e-3)),
             TILE_CENTER_M + float(rng.uniform(-5e-3, 5e-3)),
         ),
+        **_realism(opts, r, depth, rng),
     )
     left, win_l = _render_side(stereo, "left", geo, sh, opts, rng)
     right, win_r = _render_side(stereo, "right", geo.transformed(stereo.R, stereo.T), sh, opts, rng)

@@ -133,7 +133,13 @@ def test_sizes_and_types():
     with pytest.raises(ImageError, match="uint8 or uint16"):
         measure_hole(r.left.astype(np.float32), r.right.astype(np.float32), small_stereo())
     with pytest.raises(ImageError, match="single-channel"):
-        measure_hole(np.dstack([r.left] * 3), np.dstack([r.right] * 3), small_stereo())
+        measure_hole(r.left[None], r.right[None], small_stereo())
+    # colour (BGR) is converted to luma; 8-bit data in uint16 is read as 8-bit
+    gray = measure_hole(r.left, r.right, small_stereo())
+    colour = measure_hole(np.dstack([r.left] * 3), np.dstack([r.right] * 3), small_stereo())
+    wide = measure_hole(r.left.astype(np.uint16), r.right.astype(np.uint16), small_stereo())
+    assert abs(colour.radius_m - gray.radius_m) < 1e-9
+    assert abs(wide.radius_m - gray.radius_m) < 0.2e-6
 
 
 def test_calibration_for_another_image_size():
