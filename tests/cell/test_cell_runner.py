@@ -60,7 +60,7 @@ def test_every_hole_measured_once_and_accurately(small_cell: SmallCell, tmp_path
 
 
 def test_thermal_update_from_reference_rounds(small_cell: SmallCell, tmp_path: Path) -> None:
-    world = WorldOptions(speed=1500.0, drift_offset_s=0.0)
+    world = WorldOptions(speed=400.0, drift_offset_s=0.0)
     with SimCell.start(small_cell.cell, world) as sim:
         result, stored, _ = _run(small_cell, tmp_path, sim, rounds=3)
         err = truth_error(sim.world, stored)
