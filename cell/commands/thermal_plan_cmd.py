@@ -1,7 +1,7 @@
 """``holecell thermal plan-views``: the reference plan designed for the tour.
 
     holecell thermal plan-views --cell CELL [--tour tour.json] -o views.csv [--views N]
-        [--try-target X,Y,Z ...]
+        [--try-target X,Y,Z ...] [--hours 2] [--every-s 300] [--noise-um 5]
 
 Chooses the reference views that minimise the thermal model's predicted error at the tour's
 stops (:mod:`robots.thermal.design`, the plan ``holecell run`` uses), writes them as CSV
@@ -17,11 +17,12 @@ import csv
 import io
 import math
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from cell.commands.argtypes import non_negative_int
+from cell.commands.argtypes import non_negative_int, positive_float
 from cell.config import CellConfig, ReferenceTarget, load_cell
 from cell.errors import CellError
 from cell.run.reference import design_reference_plan, hole_stops
@@ -57,6 +58,21 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="a candidate position (cell frame, m, normal up) for a further reference target: "
         "prints the predicted residual with it (repeatable)",
     )  # fmt: skip
+    d = DesignOptions()
+    p.add_argument(
+        "--hours",
+        type=positive_float,
+        default=d.duration_s / 3600,
+        help="reference warm-up duration (h, default %(default)g)",
+    )
+    p.add_argument(
+        "--every-s",
+        type=positive_float,
+        default=d.every_s,
+        help="period of the reference rounds (s, default %(default)g)",
+    )
+    p.add_argument("--noise-um", type=positive_float, default=d.noise_m * 1e6,
+                   help="stereo noise per axis (um, default %(default)g)")  # fmt: skip
     p.set_defaults(handler=run_plan_views)
 
 
@@ -150,7 +166,14 @@ def run_plan_views(args: argparse.Namespace) -> int:
         raise CellError(f"-o {args.output}: the directory {args.output.parent} does not exist")
     extra = [_target(t, k) for k, t in enumerate(args.try_target)]
     names, stops = _stops(cell, args.tour)
-    options = DesignOptions(n_views=args.views or None)
+    if args.every_s > args.hours * 3600:
+        raise CellError(
+            f"--every-s {args.every_s:g}: longer than the warm-up (--hours {args.hours:g})"
+        )
+    options = DesignOptions(
+        n_views=args.views or None, duration_s=args.hours * 3600, every_s=args.every_s,
+        noise_m=args.noise_um * 1e-6,
+    )  # fmt: skip
     design = design_reference_plan(cell, stops, options)
     write_views(args.output, design)
     rms = design.predicted_rms_m
@@ -174,8 +197,8 @@ def run_plan_views(args: argparse.Namespace) -> int:
     n_more = len(design.views) + 3
     for t in extra:
         with_t = cell.model_copy(update={"reference_targets": [*cell.reference_targets, t]})
-        more = design_reference_plan(with_t, stops, DesignOptions(n_views=n_more))
-        same = design_reference_plan(cell, stops, DesignOptions(n_views=n_more))
+        more = design_reference_plan(with_t, stops, replace(options, n_views=n_more))
+        same = design_reference_plan(cell, stops, replace(options, n_views=n_more))
         used = sum(v.target_id == t.id for v in more.views)
         print(
             f"with a target at {t.position}: {n_more} views ({used} of it) RMS "
