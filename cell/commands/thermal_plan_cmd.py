@@ -1,13 +1,13 @@
 """``holecell thermal plan-views``: the reference plan designed for the tour.
 
     holecell thermal plan-views --cell CELL [--tour tour.json] -o views.csv [--views N]
-        [--try-target X,Y,Z ...] [--hours 2] [--every-s 300] [--noise-um 5]
+        [--try-target X,Y,Z ...] [--suggest-target] [--hours 2] [--every-s 300] [--noise-um 5]
 
 Chooses the reference views that minimise the thermal model's predicted error at the tour's
 stops (:mod:`robots.thermal.design`, the plan ``holecell run`` uses), writes them as CSV
 (``view_id, target_id, q1_rad .. q6_rad, tilt_rad, azimuth_rad``) and prints the predicted
 residual per stop, the old recommended plan's for comparison, and what a further target at each
-``--try-target`` position would give.
+``--try-target`` position (or the best places found by ``--suggest-target``) would give.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from cell.config import CellConfig, ReferenceTarget, load_cell
 from cell.errors import CellError
 from cell.run.reference import design_reference_plan, hole_stops
 from cell.run.setup import check_tour
+from cell.run.target_suggest import suggest_targets
 from planner import load_tour
 from robots.thermal.design import Design, DesignOptions, evaluate
 from robots.thermal.plan import view_plan
@@ -57,6 +58,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--try-target", action="append", default=[], metavar="X,Y,Z",
         help="a candidate position (cell frame, m, normal up) for a further reference target: "
         "prints the predicted residual with it (repeatable)",
+    )  # fmt: skip
+    p.add_argument(
+        "--suggest-target", action="store_true",
+        help="score places for a further target on the top faces of the environment's upright "
+        "boxes (0.1 m grid) and print the best three (takes some seconds)",
     )  # fmt: skip
     d = DesignOptions()
     p.add_argument(
@@ -205,5 +211,15 @@ def run_plan_views(args: argparse.Namespace) -> int:
             f"{more.predicted_rms_m * 1e6:.2f} um; {n_more} views of the present targets "
             f"{same.predicted_rms_m * 1e6:.2f} um"
         )
+    if args.suggest_target:
+        baseline, scores = suggest_targets(cell, stops, options)
+        print(
+            f"a further target, {len(scores)} places on environment boxes scored: "
+            f"{len(design.views) + 3} views of the present targets give {baseline * 1e6:.2f} um"
+        )
+        for sc in scores[:3]:
+            x, y, z = sc.position_m
+            print(f"  at ({x:.3f}, {y:.3f}, {z:.3f}) m: {sc.predicted_rms_m * 1e6:.2f} um "
+                  f"({sc.views_of_it} views of it)")  # fmt: skip
     print(f"wrote {len(design.views)} views to {args.output}")
     return 0
