@@ -1,13 +1,13 @@
 """``holecell thermal plan-views``: the reference plan designed for the tour.
 
     holecell thermal plan-views --cell CELL [--tour tour.json] -o views.csv [--views N]
-        [--try-target X,Y,Z ...]
+        [--try-target X,Y,Z ...] [--suggest-target] [--hours 2] [--every-s 300] [--noise-um 5]
 
 Chooses the reference views that minimise the thermal model's predicted error at the tour's
 stops (:mod:`robots.thermal.design`, the plan ``holecell run`` uses), writes them as CSV
 (``view_id, target_id, q1_rad .. q6_rad, tilt_rad, azimuth_rad``) and prints the predicted
 residual per stop, the old recommended plan's for comparison, and what a further target at each
-``--try-target`` position would give.
+``--try-target`` position (or the best places found by ``--suggest-target``) would give.
 """
 
 from __future__ import annotations
@@ -17,15 +17,17 @@ import csv
 import io
 import math
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from cell.commands.argtypes import non_negative_int
+from cell.commands.argtypes import non_negative_int, positive_float
 from cell.config import CellConfig, ReferenceTarget, load_cell
 from cell.errors import CellError
 from cell.run.reference import design_reference_plan, hole_stops
 from cell.run.setup import check_tour
+from cell.run.target_suggest import suggest_targets
 from planner import load_tour
 from robots.thermal.design import Design, DesignOptions, evaluate
 from robots.thermal.plan import view_plan
@@ -57,6 +59,26 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="a candidate position (cell frame, m, normal up) for a further reference target: "
         "prints the predicted residual with it (repeatable)",
     )  # fmt: skip
+    p.add_argument(
+        "--suggest-target", action="store_true",
+        help="score places for a further target on the top faces of the environment's upright "
+        "boxes (0.1 m grid) and print the best three (takes some seconds)",
+    )  # fmt: skip
+    d = DesignOptions()
+    p.add_argument(
+        "--hours",
+        type=positive_float,
+        default=d.duration_s / 3600,
+        help="reference warm-up duration (h, default %(default)g)",
+    )
+    p.add_argument(
+        "--every-s",
+        type=positive_float,
+        default=d.every_s,
+        help="period of the reference rounds (s, default %(default)g)",
+    )
+    p.add_argument("--noise-um", type=positive_float, default=d.noise_m * 1e6,
+                   help="stereo noise per axis (um, default %(default)g)")  # fmt: skip
     p.set_defaults(handler=run_plan_views)
 
 
@@ -150,7 +172,14 @@ def run_plan_views(args: argparse.Namespace) -> int:
         raise CellError(f"-o {args.output}: the directory {args.output.parent} does not exist")
     extra = [_target(t, k) for k, t in enumerate(args.try_target)]
     names, stops = _stops(cell, args.tour)
-    options = DesignOptions(n_views=args.views or None)
+    if args.every_s > args.hours * 3600:
+        raise CellError(
+            f"--every-s {args.every_s:g}: longer than the warm-up (--hours {args.hours:g})"
+        )
+    options = DesignOptions(
+        n_views=args.views or None, duration_s=args.hours * 3600, every_s=args.every_s,
+        noise_m=args.noise_um * 1e-6,
+    )  # fmt: skip
     design = design_reference_plan(cell, stops, options)
     write_views(args.output, design)
     rms = design.predicted_rms_m
@@ -174,13 +203,23 @@ def run_plan_views(args: argparse.Namespace) -> int:
     n_more = len(design.views) + 3
     for t in extra:
         with_t = cell.model_copy(update={"reference_targets": [*cell.reference_targets, t]})
-        more = design_reference_plan(with_t, stops, DesignOptions(n_views=n_more))
-        same = design_reference_plan(cell, stops, DesignOptions(n_views=n_more))
+        more = design_reference_plan(with_t, stops, replace(options, n_views=n_more))
+        same = design_reference_plan(cell, stops, replace(options, n_views=n_more))
         used = sum(v.target_id == t.id for v in more.views)
         print(
             f"with a target at {t.position}: {n_more} views ({used} of it) RMS "
             f"{more.predicted_rms_m * 1e6:.2f} um; {n_more} views of the present targets "
             f"{same.predicted_rms_m * 1e6:.2f} um"
         )
+    if args.suggest_target:
+        baseline, scores = suggest_targets(cell, stops, options)
+        print(
+            f"a further target, {len(scores)} places on environment boxes scored: "
+            f"{len(design.views) + 3} views of the present targets give {baseline * 1e6:.2f} um"
+        )
+        for sc in scores[:3]:
+            x, y, z = sc.position_m
+            print(f"  at ({x:.3f}, {y:.3f}, {z:.3f}) m: {sc.predicted_rms_m * 1e6:.2f} um "
+                  f"({sc.views_of_it} views of it)")  # fmt: skip
     print(f"wrote {len(design.views)} views to {args.output}")
     return 0

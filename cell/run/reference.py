@@ -71,19 +71,19 @@ def design_reference_plan(
     arm = cell.build_arm()
     targets = {r.id: (r.position, r.normal) for r in cell.reference_targets}
     stops = hole_stops(cell)[1] if stops_q is None else np.atleast_2d(np.asarray(stops_q, float))
+    cands, skipped = candidate_views(
+        arm.dh, arm.lower, arm.upper, cell.T_cell_base(), cell.T_tool0_tcp(), targets,
+        cell.tool.standoff_m, options, accept=lambda q: not arm.in_collision(q),
+        rest_q=cell.home_q(),
+    )  # fmt: skip
     try:
-        cands, skipped = candidate_views(
-            arm.dh, arm.lower, arm.upper, cell.T_cell_base(), cell.T_tool0_tcp(), targets,
-            cell.tool.standoff_m, options, accept=lambda q: not arm.in_collision(q),
-            rest_q=cell.home_q(),
-        )  # fmt: skip
         design = design_views(
             arm.dh, cell.T_cell_base(), cell.T_tool0_tcp(), cands, stops, options,
             n_targets=len(targets),
         )  # fmt: skip
     except ThermalError as exc:
-        where = "; ".join(f"{t}: {r}" for t, r in skipped.items()) if "skipped" in locals() else ""
-        raise CellError(f"cell {cell.name!r}: {exc}" + (f" ({where})" if where else "")) from exc
+        why = "; ".join(f"{t}: {r}" for t, r in skipped.items())
+        raise CellError(f"cell {cell.name!r}: {exc}" + (f" ({why})" if why else "")) from exc
     return replace(design, skipped=skipped)
 
 

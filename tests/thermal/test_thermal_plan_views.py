@@ -118,3 +118,19 @@ def test_bad_views_csv_is_refused_naming_line_and_column(small, tmp_path, capsys
                  str(tmp_path / "obs.csv")])  # fmt: skip
     err = capsys.readouterr().err
     assert code == 2 and needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_suggested_places_are_on_the_table_and_scored(small):
+    from cell.run.target_suggest import suggest_targets, top_face_points
+
+    cell = load_cell(small[0])
+    table = next(o for o in cell.environment.obstacles if o.name == "table")
+    top_z = table.pose.xyz[2] + table.box.size[2] / 2
+    points = top_face_points(cell, spacing_m=0.5)
+    assert points and all(abs(p[2] - top_z - 0.001) < 1e-9 for p in points)
+    stops = np.array([s["q"] for s in __import__("json").loads(small[1].read_text())["stops"]])
+    baseline, scores = suggest_targets(cell, stops, spacing_m=0.5)
+    assert np.isfinite(baseline) and scores
+    rms = [s.predicted_rms_m for s in scores]
+    assert rms == sorted(rms) and any(s.views_of_it > 0 for s in scores)
+    assert {s.position_m for s in scores} <= {tuple(float(v) for v in p) for p in points}
