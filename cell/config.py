@@ -20,11 +20,11 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError,
 
 from cell.errors import ConfigError
 from cell.uncertainty.materials import (
-    ALPHA_MAX_PER_K,
-    ALPHA_MIN_PER_K,
     BUILTIN_MATERIALS,
     DEFAULT_MATERIAL,
     Material,
+    MaterialSpec,
+    material_field,
 )
 from robots import DEFAULT_MODEL, Arm, LimitScaling, LimitsError, RobotModelError, Shape
 from robots.transforms import pose_to_matrix
@@ -165,26 +165,6 @@ class Hole(_Strict):
 PART_TEMPERATURE_RANGE_C = (-10.0, 50.0)
 
 
-class MaterialSpec(_Strict):
-    """The part's material: expansion coefficient (1/K) and its standard uncertainty."""
-
-    name: Annotated[str, Field(min_length=1)]
-    alpha_per_K: Annotated[float, Field(ge=ALPHA_MIN_PER_K, le=ALPHA_MAX_PER_K)]  # noqa: N815
-    u_alpha_per_K: Annotated[float, Field(ge=0, le=1e-4)]  # noqa: N815
-
-
-def _material(value: Any) -> Any:
-    """A built-in material name becomes its figures; a mapping is validated as given."""
-    if isinstance(value, str):
-        if value not in BUILTIN_MATERIALS:
-            known = ", ".join(sorted(BUILTIN_MATERIALS))
-            raise ValueError(f"unknown material (built-in: {known}; or give name, alpha_per_K "
-                             "and u_alpha_per_K)")  # fmt: skip
-        m = BUILTIN_MATERIALS[value]
-        return {"name": m.name, "alpha_per_K": m.alpha_per_K, "u_alpha_per_K": m.u_alpha_per_K}
-    return value
-
-
 class Part(_Strict):
     base: Pose = IDENTITY
     holes: list[Hole] = []
@@ -199,7 +179,7 @@ class Part(_Strict):
     #: standard uncertainty of ``temperature_c`` (K)
     u_temperature_K: Annotated[float, Field(gt=0, le=10)] | None = None  # noqa: N815
 
-    _material = field_validator("material", mode="before")(lambda cls, v: _material(v))
+    _material = field_validator("material", mode="before")(lambda cls, v: material_field(v))
 
 
 class Environment(_Strict):

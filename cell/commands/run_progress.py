@@ -43,6 +43,8 @@ class RunBars:
                 if r.position_deviation_m is not None
                 else r.reason[:40]
             )
+            if r.U_position_m is not None:
+                dev += f" U {r.U_position_m * 1e3:.4f} mm {r.decision or ''}"
             self._draw(f"holes {bar(self.done, self.total)} {self.done}/{self.total}  "
                        f"{r.hole_id:<8} {r.status:<7} {dev}")  # fmt: skip
 

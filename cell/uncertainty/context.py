@@ -16,7 +16,7 @@ from cell.uncertainty.calibration import default_uncertainty, jacobian_covarianc
 from cell.uncertainty.decision import DEFAULT_RULE
 from cell.uncertainty.part_temperature import PartThermalState, part_state
 from cell.uncertainty.repeatability import repeatability_rp_m, sigma_per_axis_m
-from cell.uncertainty.thermal import thermal_point_covariance
+from cell.uncertainty.thermal import thermal_note, thermal_point_covariance
 from measure import StereoCalibration
 from measure.calibration_uncertainty import CalibrationUncertainty
 from robots.thermal.model import ThermalModel
@@ -83,9 +83,7 @@ def hole_contributions(
     calib = Contribution("stereo_calibration", R_part_left @ cal[:3, :3] @ R_part_left.T,
                          4.0 * cal[3, 3], ctx.calibration_note)  # fmt: skip
     th = thermal_point_covariance(model, T_cell_base, T_tool0_tcp, q_rad, temps_c, center_tcp_m)
-    th_note = ("identified terms' standard deviations (correlations not stored: taken as "
-               "independent)" if model is not None else
-               "no thermal model: nominal kinematics, their drift is not covered")  # fmt: skip
+    th_note = thermal_note(model)
     thermal = Contribution("thermal_model", R_part_cell @ th @ R_part_cell.T, 0.0, th_note)
     s = sigma_per_axis_m(ctx.rp_m)
     rep = Contribution(

@@ -8,6 +8,9 @@ knows the alloy (``part.material: {name, alpha_per_K, u_alpha_per_K}``).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Annotated, Any
+
+from pydantic import BaseModel, ConfigDict, Field
 
 #: limits of a plausible expansion coefficient (1/K): beyond them the figure is a mistake
 #: (11.5 written for 11.5e-6, a unit mixed up); the range spans invar to filled plastics
@@ -38,3 +41,27 @@ BUILTIN_MATERIALS: dict[str, Material] = {
 
 #: the material assumed when a cell file names none (the built-in frame is steel)
 DEFAULT_MATERIAL = "steel"
+
+
+class MaterialSpec(BaseModel):
+    """``part.material`` of a cell file: name, expansion coefficient (1/K) and its standard
+    uncertainty (1/K), each checked for a plausible range."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    name: Annotated[str, Field(min_length=1)]
+    alpha_per_K: Annotated[float, Field(ge=ALPHA_MIN_PER_K, le=ALPHA_MAX_PER_K)]  # noqa: N815
+    u_alpha_per_K: Annotated[float, Field(ge=0, le=1e-4)]  # noqa: N815
+
+
+def material_field(value: Any) -> Any:
+    """``part.material`` before validation: a built-in name becomes its figures; a mapping is
+    validated as given (:class:`MaterialSpec`); an unknown name is a ``ValueError``."""
+    if isinstance(value, str):
+        if value not in BUILTIN_MATERIALS:
+            known = ", ".join(sorted(BUILTIN_MATERIALS))
+            raise ValueError(f"unknown material (built-in: {known}; or give name, alpha_per_K "
+                             "and u_alpha_per_K)")  # fmt: skip
+        m = BUILTIN_MATERIALS[value]
+        return {"name": m.name, "alpha_per_K": m.alpha_per_K, "u_alpha_per_K": m.u_alpha_per_K}
+    return value

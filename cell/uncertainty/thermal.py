@@ -5,10 +5,10 @@ The compensated pose ``T_cell_tcp(q, T; theta)`` depends on the identified terms
 ``p_cell = T_cell_tcp(theta) p_tcp``. :func:`thermal_point_covariance` propagates it by central
 differences of +-1 sigma per term (GUM's law of propagation).
 
-Today :func:`robots.thermal.identify.identify` keeps only each term's standard deviation
-(``ThermalModel.std``), not their correlations, so the terms are taken as independent here. When
-``robots.thermal`` offers the prediction covariance itself, :func:`thermal_point_covariance` is
-the one function to switch over.
+When the model offers its own prediction covariance (``ThermalModel.predict_covariance``, from
+the terms' full covariance kept with the model), that is used. Otherwise (a model without it) the
+terms' standard deviations (``ThermalModel.std``) are propagated here with the terms taken as
+independent. :func:`thermal_point_covariance` is the one function that decides.
 """
 
 from __future__ import annotations
@@ -37,7 +37,12 @@ def thermal_point_covariance(
     compensated kinematics at joints ``q_rad`` and readings ``temps_c`` (degC), from the
     model's term uncertainties. Zero without a model (the nominal kinematics have no identified
     terms; their error is then not covered: the budget notes it)."""
-    if model is None or not model.std:
+    if model is None:
+        return np.zeros((3, 3))
+    predict = getattr(model, "predict_covariance", None)
+    if predict is not None:
+        return np.asarray(predict(q_rad, temps_c, np.asarray(p_tcp_m, float), T_cell_base), float)
+    if not model.std:
         return np.zeros((3, 3))
     p = np.append(np.asarray(p_tcp_m, float), 1.0)
     cols = []
@@ -56,3 +61,12 @@ def thermal_point_covariance(
         return np.zeros((3, 3))
     J = np.column_stack(cols)
     return J @ J.T
+
+
+def thermal_note(model: ThermalModel | None) -> str:
+    """Where the thermal component's figures come from (for the budget)."""
+    if model is None:
+        return "no thermal model: nominal kinematics, their drift is not covered"
+    if getattr(model, "predict_covariance", None) is not None:
+        return "the thermal model's prediction covariance (identified terms' full covariance)"
+    return "identified terms' standard deviations (correlations not stored: taken as independent)"

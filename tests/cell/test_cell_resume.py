@@ -24,14 +24,16 @@ FAST_LINK = LinkOptions(response_timeout_s=0.05, retries=20, heartbeat_period_s=
 WORLD = WorldOptions(speed=1500.0)
 
 
-def _runner(sc: SmallCell, run_dir: Path, sim: SimCell, resume: bool, progress=None):
+def _runner(sc: SmallCell, run_dir: Path, sim: SimCell, resume: bool, progress=None,
+            part_c: float | None = None):  # fmt: skip
     if resume:
         files = resume_run(run_dir)
     else:
         files = start_run(run_dir, sc.cell, sc.tour, "tour.json", sim.url, sc.reference)
     client = ControllerClient(sim.url, FAST_LINK)
     client.connect()
-    options = RunOptions(settle_s=0.0, reconnect_budget_s=5.0)  # default reference rounds
+    options = RunOptions(settle_s=0.0, reconnect_budget_s=5.0,  # default reference rounds
+                         part_temperature_c=part_c)  # fmt: skip
     runner = Runner(files.cell, files.tour, files.store, client, sim.camera, options,
                     files.reference, progress=progress)  # fmt: skip
     return runner, files, client
@@ -51,7 +53,7 @@ def test_resume_after_estop_at_a_hole_with_default_reference_rounds(
     assert RunOptions().reference_rounds > 0
     with SimCell.start(small_cell.cell, WORLD) as sim:
         runner, files, client = _runner(small_cell, tmp_path, sim, False,
-                                        _estop_while_inspecting(sim))  # fmt: skip
+                                        _estop_while_inspecting(sim), part_c=24.5)  # fmt: skip
         try:
             with pytest.raises(RunFaultError):
                 runner.run()
@@ -72,6 +74,10 @@ def test_resume_after_estop_at_a_hole_with_default_reference_rounds(
     assert [r.hole_id for r in stored] == small_cell.tour.hole_order
     assert any("off home" in e["message"] for e in events)
     assert sum(e["kind"] == "state" and e["state"] == "reference" for e in events) == 2
+    # the part temperature given to the first run holds for the holes the resumed run measured
+    assert all("part at 24.50 degC" in r.budget["notes"][0] for r in stored if r.measured)
+    assert all(r.decision in ("conforming", "inconclusive", "nonconforming") for r in stored
+               if r.measured)  # fmt: skip
 
 
 def _cli(sc: SmallCell, sim: SimCell, cam: CameraServer, run_dir: Path, *extra: str) -> int:
