@@ -45,7 +45,9 @@ class HoleCandidate:
 
     ``threshold`` separates hole from surface (gray level as a fraction of full scale),
     ``polarity`` is ``"dark"`` (hole darker than the surface) or ``"bright"``;
-    ``levels`` is how many ladder levels gave this region (its plateau length).
+    ``levels`` is how many ladder levels gave this region (its plateau length);
+    ``alternates`` the same hole's regions at the other levels (another run of levels),
+    which the left/right cross-check may prefer when their sizes agree better.
     """
 
     centroid_px: tuple[float, float]
@@ -55,6 +57,7 @@ class HoleCandidate:
     threshold: float
     touches_border: bool
     levels: int = 1
+    alternates: tuple[HoleCandidate, ...] = ()
 
 
 def to_gray(img: object, which: str) -> np.ndarray:
@@ -193,7 +196,9 @@ def _discs(mask: np.ndarray, min_area: float, level: int) -> list[tuple]:
 
 
 def _plateau(members: list[tuple]) -> tuple:
-    """The member in the middle of the longest run of levels with the same diameter."""
+    """The member in the middle of the longest run of levels with the same diameter (of
+    equally long runs the darkest, unless they are single levels: then the largest region,
+    the rim around a patchy interior), plus the run length and the other runs' middles."""
     members = sorted(members, key=lambda m: m[5])
     runs: list[list[tuple]] = [[members[0]]]
     for m in members[1:]:
@@ -203,14 +208,20 @@ def _plateau(members: list[tuple]) -> tuple:
             runs[-1].append(m)
         else:
             runs.append([m])
-    best = max(runs, key=len)  # max keeps the first (darkest) of equally long runs
-    return best[len(best) // 2] + (len(best),)
+    longest = max(len(r) for r in runs)
+    if longest == 1:
+        best = max(runs, key=lambda r: r[0][2])
+    else:
+        best = next(r for r in runs if len(r) == longest)
+    others = tuple(r[len(r) // 2] for r in runs if r is not best)
+    return best[len(best) // 2] + (len(best), others)
 
 
 def _group(discs: list[tuple]) -> list[tuple]:
     """Group discs found at several levels into holes; drop discs inside a larger hole.
 
-    Returns (cx, cy, area, bbox, border, level, plateau length) per hole.
+    Returns (cx, cy, area, bbox, border, level, plateau length, other levels' discs) per
+    hole.
     """
     groups: list[list[tuple]] = []
     for d in sorted(discs, key=lambda d: -d[2]):
@@ -227,8 +238,10 @@ def _group(discs: list[tuple]) -> list[tuple]:
     return [
         p
         for p in picks
-        if not any(
-            q[2] > p[2] and np.hypot(p[0] - q[0], p[1] - q[1]) < np.sqrt(q[2] / np.pi)
+        if not any(  # inside a larger disc that holds over at least as many levels
+            q[2] > p[2]
+            and q[6] >= p[6]
+            and np.hypot(p[0] - q[0], p[1] - q[1]) < np.sqrt(q[2] / np.pi)
             for q in picks
         )
     ]
@@ -291,18 +304,24 @@ def find_candidates(
     order = [(p, t, [h for h in hs if h[6] >= 2]) for p, (t, hs) in found.items()]
     order += [(p, t, hs) for p, (t, hs) in found.items()]
     for polarity, thresholds, holes in order:
-        if not holes:
-            continue
-        return [
-            HoleCandidate(
-                centroid_px=(cx * s + s // 2 + ox, cy * s + s // 2 + oy),
-                bbox=(bx * s + ox, by * s + oy, bw * s, bh * s),
-                diameter_px=float(2.0 * np.sqrt(area / np.pi) * s),
-                polarity=polarity,
-                threshold=float(thresholds[level]) / 255.0,
-                touches_border=border,
-                levels=n_levels,
-            )
-            for cx, cy, area, (bx, by, bw, bh), border, level, n_levels in holes
-        ]
+        if holes:
+            return [_candidate(h, polarity, thresholds, (ox, oy)) for h in holes]
     return []
+
+
+def _candidate(hole: tuple, polarity: str, thresholds: list[float], origin) -> HoleCandidate:
+    """A :class:`HoleCandidate` (full-resolution pixels) from a :func:`_group` entry."""
+    s = SEARCH_SCALE
+    ox, oy = origin
+    cx, cy, area, (bx, by, bw, bh), border, level = hole[:6]
+    others = hole[7] if len(hole) > 7 else ()
+    return HoleCandidate(
+        centroid_px=(cx * s + s // 2 + ox, cy * s + s // 2 + oy),
+        bbox=(bx * s + ox, by * s + oy, bw * s, bh * s),
+        diameter_px=float(2.0 * np.sqrt(area / np.pi) * s),
+        polarity=polarity,
+        threshold=float(thresholds[level]) / 255.0,
+        touches_border=border,
+        levels=hole[6] if len(hole) > 6 else 1,
+        alternates=tuple(_candidate(o, polarity, thresholds, origin) for o in others),
+    )
