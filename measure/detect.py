@@ -9,7 +9,7 @@ the hole is the longest *plateau* — consecutive levels giving the same diamete
 4 % — and of equal plateaus the darker one: a sharp rim gives the same region over a
 wide range of levels, while a chamfer ring, a shadow or a soft lip joins the region only
 at some levels. A small disc inside a larger one (a dark fragment of a screw or its
-shadow inside the bore) belongs to the larger one and is dropped. Discs that hold over
+shadow inside the bore) belongs to the larger one and is dropped. Discs that show at
 two or more levels come first (a shadow or a stain next to the hole, or texture near the
 surface level, shows at one level only): dark ones, else bright ones (a through-hole
 against a lit background), and only if there are none, one-level discs. A dark disc
@@ -45,7 +45,9 @@ class HoleCandidate:
 
     ``threshold`` separates hole from surface (gray level as a fraction of full scale),
     ``polarity`` is ``"dark"`` (hole darker than the surface) or ``"bright"``;
-    ``levels`` is how many ladder levels gave this region (its plateau length).
+    ``levels`` is how many ladder levels gave this region (its plateau length);
+    ``alternates`` the same hole's regions at the other levels (another run of levels),
+    which the left/right cross-check may prefer when their sizes agree better.
     """
 
     centroid_px: tuple[float, float]
@@ -55,6 +57,7 @@ class HoleCandidate:
     threshold: float
     touches_border: bool
     levels: int = 1
+    alternates: tuple[HoleCandidate, ...] = ()
 
 
 def to_gray(img: object, which: str) -> np.ndarray:
@@ -165,35 +168,58 @@ def _disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
 
 
 def _levels(small: np.ndarray):
-    """(polarity, [thresholds 0..255]) for the dark class, then the bright class."""
+    """(polarity, [thresholds 0..255], extreme level) for the dark class, then the bright."""
     p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
     if p_med - p_lo >= 0.2 * 255:
-        yield "dark", [p_lo + f * (p_med - p_lo) for f in LADDER]
+        yield "dark", [p_lo + f * (p_med - p_lo) for f in LADDER], p_lo
     if p_hi - p_med >= 0.2 * 255:
-        yield "bright", [p_hi - f * (p_hi - p_med) for f in LADDER]
+        yield "bright", [p_hi - f * (p_hi - p_med) for f in LADDER], p_hi
 
 
-def _discs(mask: np.ndarray, min_area: float, level: int) -> list[tuple]:
-    """Disc-like outer regions of a mask: (cx, cy, area, bbox, border, level) in search px."""
+def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, reach) -> list[tuple]:
+    """Disc-like outer regions of a mask: (cx, cy, area, bbox, border, level) in search px.
+
+    Outlines shorter than the smallest disc's perimeter, or filling their box far less
+    than an ellipse does (π/4), are passed over before the disc test. Regions touching
+    the border are tested only with ``border_only`` (then only they are). ``reach(x, y,
+    w, h)`` tells how far past the threshold a box reaches (0: not at all, 1: to the
+    image's extreme): a region must reach 0.5 — a hole's interior goes far past the
+    threshold that outlines it, a texture speck or a shadow barely crosses it.
+    """
     H, W = mask.shape
     contours, _ = cv2.findContours(mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    min_len = max(8, int(2.0 * np.sqrt(np.pi * min_area)))  # 2√(π A) ≈ the disc's perimeter
     out = []
     for c in contours:
-        if len(c) < 8:
+        if len(c) < min_len:
+            continue
+        x, y, w, h = cv2.boundingRect(c)
+        if w * h < min_area:
             continue
         m = cv2.moments(c)
         area = m["m00"]
         if area < min_area or area > 0.5 * H * W:
             continue
-        x, y, w, h = cv2.boundingRect(c)
         border = x == 0 or y == 0 or x + w == W or y + h == H
+        if border != border_only:
+            continue
+        if not border and (
+            area < 0.5 * w * h
+            or min(w, h) < 0.3 * max(w, h)
+            or 4.0 * np.pi * area < 0.45 * len(c) ** 2  # ragged: a disc's is about 0.8
+        ):
+            continue
+        if reach(x, y, w, h) < 0.5:
+            continue
         if _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
             out.append((m["m10"] / area, m["m01"] / area, area, (x, y, w, h), border, level))
     return out
 
 
 def _plateau(members: list[tuple]) -> tuple:
-    """The member in the middle of the longest run of levels with the same diameter."""
+    """The member in the middle of the longest run of levels with the same diameter (of
+    equally long runs the darkest, unless they are single levels: then the largest region,
+    the rim around a patchy interior), plus the run length and the other runs' middles."""
     members = sorted(members, key=lambda m: m[5])
     runs: list[list[tuple]] = [[members[0]]]
     for m in members[1:]:
@@ -203,14 +229,20 @@ def _plateau(members: list[tuple]) -> tuple:
             runs[-1].append(m)
         else:
             runs.append([m])
-    best = max(runs, key=len)  # max keeps the first (darkest) of equally long runs
-    return best[len(best) // 2] + (len(best),)
+    longest = max(len(r) for r in runs)
+    if longest == 1:
+        best = max(runs, key=lambda r: r[0][2])
+    else:
+        best = next(r for r in runs if len(r) == longest)
+    others = tuple(r[len(r) // 2] for r in runs if r is not best)
+    return best[len(best) // 2] + (len(best), others)
 
 
 def _group(discs: list[tuple]) -> list[tuple]:
     """Group discs found at several levels into holes; drop discs inside a larger hole.
 
-    Returns (cx, cy, area, bbox, border, level, plateau length) per hole.
+    Returns (cx, cy, area, bbox, border, level, plateau length, other levels' discs,
+    number of levels the hole shows at) per hole.
     """
     groups: list[list[tuple]] = []
     for d in sorted(discs, key=lambda d: -d[2]):
@@ -223,15 +255,34 @@ def _group(discs: list[tuple]) -> list[tuple]:
                 break
         else:
             groups.append([d])
-    picks = [_plateau(g) for g in groups]
-    return [
-        p
-        for p in picks
-        if not any(
-            q[2] > p[2] and np.hypot(p[0] - q[0], p[1] - q[1]) < np.sqrt(q[2] / np.pi)
-            for q in picks
-        )
-    ]
+    picks = [(*_plateau(g), len({m[5] for m in g})) for g in groups]
+    if len(picks) < 2:
+        return picks
+    xy = np.array([(p[0], p[1]) for p in picks])
+    area = np.array([p[2] for p in picks])
+    n_lev = np.array([p[8] for p in picks])
+    dist = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
+    # p (row) lies inside a larger disc q (column) that holds over at least as many levels
+    inside = (
+        (area[None, :] > area[:, None])
+        & (n_lev[None, :] >= n_lev[:, None])
+        & (dist < np.sqrt(area / np.pi)[None, :])
+    )
+    return [p for p, nested in zip(picks, inside.any(axis=1), strict=True) if not nested]
+
+
+def _reach(small: np.ndarray, polarity: str, thr: float, extreme: float):
+    """``reach(x, y, w, h)`` for :func:`_discs`: how far past ``thr`` toward ``extreme``
+    the darkest (bright class: brightest) pixel of the box goes (0 … 1)."""
+    span = max(abs(thr - extreme), 1.0)
+
+    def reach(x: int, y: int, w: int, h: int) -> float:
+        box = small[y : y + h, x : x + w]
+        if polarity == "dark":
+            return (thr - float(box.min())) / span
+        return (float(box.max()) - thr) / span
+
+    return reach
 
 
 def _cross_polarity(found: dict[str, tuple[list, list]]) -> None:
@@ -262,7 +313,7 @@ def _cross_polarity(found: dict[str, tuple[list, list]]) -> None:
 def find_candidates(
     small: np.ndarray,
     roi: tuple[int, int, int, int] | None = None,
-    min_diameter_px: float = 12.0,
+    min_diameter_px: float = 16.0,
 ) -> list[HoleCandidate]:
     """Disc-like dark regions (else bright ones) in the search image (optionally in ``roi``).
 
@@ -279,30 +330,42 @@ def find_candidates(
         if min(small.shape) < 4:
             return []
     min_area = np.pi * (0.5 * min_diameter_px / s) ** 2
+    small = cv2.medianBlur(small, 3)  # texture and noise specks would each be an outline
     found = {}
-    for polarity, thresholds in _levels(small):
-        discs = []
-        for k, thr in enumerate(thresholds):
-            mask = (small <= thr) if polarity == "dark" else (small > thr)
-            discs += _discs(mask, min_area, k)
-        found[polarity] = (thresholds, _group(discs))
+    for border_only in (False, True):  # regions cut by the border only when nothing else
+        for polarity, thresholds, extreme in _levels(small):
+            discs = []
+            for k, thr in enumerate(thresholds):
+                mask = (small <= thr) if polarity == "dark" else (small > thr)
+                discs += _discs(
+                    mask, min_area, k, border_only, _reach(small, polarity, thr, extreme)
+                )
+            found[polarity] = (thresholds, _group(discs))
+        if any(holes for _, holes in found.values()):
+            break
     _cross_polarity(found)
     # dark discs that hold over levels, else bright ones, else any dark, else any bright
-    order = [(p, t, [h for h in hs if h[6] >= 2]) for p, (t, hs) in found.items()]
+    order = [(p, t, [h for h in hs if h[8] >= 2]) for p, (t, hs) in found.items()]
     order += [(p, t, hs) for p, (t, hs) in found.items()]
     for polarity, thresholds, holes in order:
-        if not holes:
-            continue
-        return [
-            HoleCandidate(
-                centroid_px=(cx * s + s // 2 + ox, cy * s + s // 2 + oy),
-                bbox=(bx * s + ox, by * s + oy, bw * s, bh * s),
-                diameter_px=float(2.0 * np.sqrt(area / np.pi) * s),
-                polarity=polarity,
-                threshold=float(thresholds[level]) / 255.0,
-                touches_border=border,
-                levels=n_levels,
-            )
-            for cx, cy, area, (bx, by, bw, bh), border, level, n_levels in holes
-        ]
+        if holes:
+            return [_candidate(h, polarity, thresholds, (ox, oy)) for h in holes]
     return []
+
+
+def _candidate(hole: tuple, polarity: str, thresholds: list[float], origin) -> HoleCandidate:
+    """A :class:`HoleCandidate` (full-resolution pixels) from a :func:`_group` entry."""
+    s = SEARCH_SCALE
+    ox, oy = origin
+    cx, cy, area, (bx, by, bw, bh), border, level = hole[:6]
+    others = hole[7] if len(hole) > 7 else ()
+    return HoleCandidate(
+        centroid_px=(cx * s + s // 2 + ox, cy * s + s // 2 + oy),
+        bbox=(bx * s + ox, by * s + oy, bw * s, bh * s),
+        diameter_px=float(2.0 * np.sqrt(area / np.pi) * s),
+        polarity=polarity,
+        threshold=float(thresholds[level]) / 255.0,
+        touches_border=border,
+        levels=hole[6] if len(hole) > 6 else 1,
+        alternates=tuple(_candidate(o, polarity, thresholds, origin) for o in others),
+    )

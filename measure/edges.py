@@ -82,10 +82,9 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
     return region
 
 
-def _ring(region: np.ndarray, inner: int, outer: int) -> np.ndarray:
-    k_in = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * inner + 1, 2 * inner + 1))
-    k_out = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * outer + 1, 2 * outer + 1))
-    return (cv2.dilate(region, k_out) > 0) & ~(cv2.dilate(region, k_in) > 0)
+def _ring(outside_px: np.ndarray, inner: float, outer: float) -> np.ndarray:
+    """Pixels between ``inner`` and ``outer`` px outside the region (from its distance map)."""
+    return (outside_px > inner) & (outside_px <= outer)
 
 
 def hole_region(
@@ -114,11 +113,13 @@ def hole_region(
     level = cand.threshold
     region = _region((roi_img <= level * full) if dark else (roi_img > level * full), seed)
     inside = outside = level
+    dist = None
     if region.any():
         k = max(4, int(0.03 * cand.diameter_px))
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
         core = cv2.erode(region, ker) > 0
-        lin, lout = _median(roi_img, core, full), _median(roi_img, _ring(region, 3, 3 + k), full)
+        dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)  # px outside the region
+        lin, lout = _median(roi_img, core, full), _median(roi_img, _ring(dist, 3, 3 + k), full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
@@ -129,13 +130,15 @@ def hole_region(
             refined = _region(mask, seed)
             ratio = float(refined.sum()) / float(region.sum())
             if 0.6 < ratio < 1.6:  # the same region, better placed; else keep the first
-                region = refined
+                region = refined  # (moved by a pixel or two: the first distance map serves)
     mom = cv2.moments(region, binaryImage=True)
     if mom["m00"] <= 0:
         return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
     centroid = (mom["m10"] / mom["m00"] + x0, mom["m01"] / mom["m00"] + y0)
     d = 2.0 * np.sqrt(mom["m00"] / np.pi)
-    wide = _median(roi_img, _ring(region, int(0.05 * d) + 1, int(0.2 * d) + 2), full)
+    if dist is None:
+        dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)
+    wide = _median(roi_img, _ring(dist, 0.05 * d, 0.2 * d), full)
     return HoleRegion(
         box,
         centroid,

@@ -5,7 +5,9 @@ Every left/right pair of candidates is checked, even when each image has only on
 - **epipolar**: after rectification both centroids lie on the same row, within
   max(6 px, 10 % of the diameter) (the centroid of a tilted hole's image is not exactly
   the image of its centre, but far closer than that);
-- **size**: two views of one hole differ in apparent diameter by less than 25 %;
+- **size**: two views of one hole differ in apparent diameter by less than 25 % (when
+  they do not, the same holes' regions at the detector's other threshold levels are
+  tried: a patchy interior gives different regions at different levels);
 - **depth**: the centroids triangulate in front of both cameras and, when the standoff
   is known, within a factor 2 of it (the disparity range);
 - **expected size**: with an expected diameter, the diameter implied by the pixel size
@@ -61,6 +63,19 @@ def _check(a, b, pa, pb, stereo, f_px, standoff_m, expected_m, tol):
     return None, figures
 
 
+def _best_levels(a, b, pa, pb, stereo, f_px, standoff_m, expected_m, tol, fig):
+    """Of the two holes' regions at every ladder level, the passing pair closest in size."""
+    best = (a, b, "size", fig)
+    for a2 in (a, *a.alternates):
+        for b2 in (b, *b.alternates):
+            failed, fig2 = _check(a2, b2, pa, pb, stereo, f_px, standoff_m, expected_m, tol)
+            if failed is None and (
+                best[2] is not None or fig2.size_difference < best[3].size_difference
+            ):
+                best = (a2, b2, None, fig2)
+    return best
+
+
 def _describe(a, b, fig: PairCheck) -> str:
     return (
         f"closest: left ⌀{a.diameter_px:.0f} px at ({a.centroid_px[0]:.0f}, "
@@ -81,6 +96,7 @@ def pick_pair(
     standoff_m: float | None = None,
 ) -> tuple[HoleCandidate, HoleCandidate, PairCheck]:
     """The left and right candidate that are one hole (see the module docstring)."""
+    left, right = list(left), list(right)
     cl = stereo.undistort_rectify(np.array([c.centroid_px for c in left]), "left")
     cr = stereo.undistort_rectify(np.array([c.centroid_px for c in right]), "right")
     f_px = float(stereo.rectification.P1[0, 0])
@@ -89,6 +105,11 @@ def pick_pair(
     for i, a in enumerate(left):
         for j, b in enumerate(right):
             failed, fig = _check(a, b, cl[i], cr[j], stereo, f_px, standoff_m, expected_m, tol)
+            if failed == "size":  # the same hole at other ladder levels may agree better
+                a, b, failed, fig = _best_levels(
+                    a, b, cl[i], cr[j], stereo, f_px, standoff_m, expected_m, tol, fig
+                )
+                left[i], right[j] = a, b
             if failed is None:
                 err = abs(fig.diameter_m / expected_m - 1.0) if expected_m else 0.0
                 good.append((err, i, j, fig))

@@ -75,18 +75,20 @@ def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour
 
 
 def _surface_level(small: np.ndarray, cand: HoleCandidate) -> float:
-    """Median of the search image in an annulus 1.0 … 1.5 diameters from the hole's centre:
+    """Median of the search image on circles 1.0 … 1.5 diameters from the hole's centre:
     the part's surface beyond any grommet or washer (fraction of full scale)."""
     s = SEARCH_SCALE
     cx, cy = (cand.centroid_px[0] - s // 2) / s, (cand.centroid_px[1] - s // 2) / s
     d = cand.diameter_px / s
+    ang = np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)
+    rad = d * np.array([1.0, 1.25, 1.5])
+    xs = np.rint(cx + np.outer(rad, np.cos(ang))).astype(int).ravel()
+    ys = np.rint(cy + np.outer(rad, np.sin(ang))).astype(int).ravel()
     H, W = small.shape
-    x0, x1 = int(max(cx - 1.5 * d, 0)), int(min(cx + 1.5 * d + 1, W))
-    y0, y1 = int(max(cy - 1.5 * d, 0)), int(min(cy + 1.5 * d + 1, H))
-    yy, xx = np.mgrid[y0:y1, x0:x1]
-    rr = np.hypot(xx - cx, yy - cy)
-    vals = small[y0:y1, x0:x1][(rr >= d) & (rr <= 1.5 * d)]
-    return float(np.median(vals)) / 255.0 if vals.size else float(np.median(small)) / 255.0
+    ok = (xs >= 0) & (ys >= 0) & (xs < W) & (ys < H)
+    if not ok.any():
+        return float(np.median(small)) / 255.0
+    return float(np.median(small[ys[ok], xs[ok]])) / 255.0
 
 
 def _rim(cl, cr, reg_l, reg_r, small_l, small_r, depth_m) -> RimChoice:
