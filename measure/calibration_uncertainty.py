@@ -10,7 +10,8 @@ budget of a hole (``cell``) propagates it through triangulation and the circle f
       "rvec_std_rad": [rx, ry, rz],     # rotation vector of R, left→right
       "T_std_m": [tx, ty, tz],
       "rms_px": 0.21,                   # stereo reprojection RMS
-      "per_view_rms_px": [[left, right], ...]
+      "per_view_rms_px": [[left, right], ...],
+      "method": "jacobian"              # optional: how the standard deviations were estimated
     }
 
 Every figure is one standard deviation (GUM standard uncertainty), in the unit its name says.
@@ -37,6 +38,9 @@ class CalibrationUncertainty:
         T_std_m: standard deviation of the left→right translation (metres).
         rms_px: reprojection RMS of the stereo solve (pixels).
         per_view_rms_px: per view (image pair), the left and right reprojection RMS (pixels).
+        method: how the standard deviations were estimated ("" when not said):
+            ``"jacobian"`` (σ²(JᵀJ)⁻¹ at the solution, :mod:`measure.calibration_covariance`)
+            or ``"max(jacobian, bootstrap over pairs xN)"``.
     """
 
     K_std_left_px: np.ndarray
@@ -47,6 +51,7 @@ class CalibrationUncertainty:
     T_std_m: np.ndarray
     rms_px: float
     per_view_rms_px: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    method: str = ""
 
     @classmethod
     def from_dict(cls, data: Any, source: str = "<memory>") -> CalibrationUncertainty:
@@ -64,6 +69,9 @@ class CalibrationUncertainty:
             )
         rms = _std(data, "rms_px", None, source, "uncertainty.")
         views = np.asarray(data.get("per_view_rms_px", []), dtype=np.float64).reshape(-1, 2)
+        method = data.get("method", "")
+        if not isinstance(method, str):
+            raise CalibrationError(source, "uncertainty.method", f"must be text, got {method!r}")
         return cls(
             K_std_left_px=cams["left"][0],
             dist_std_left=cams["left"][1],
@@ -73,11 +81,12 @@ class CalibrationUncertainty:
             T_std_m=_std(data, "T_std_m", 3, source, "uncertainty."),
             rms_px=float(rms),
             per_view_rms_px=views,
+            method=method,
         )
 
     def to_dict(self) -> dict[str, Any]:
         """The ``uncertainty`` block of ``stereo.json`` (plain lists)."""
-        return {
+        out: dict[str, Any] = {
             "left": {
                 "K_std_px": self.K_std_left_px.tolist(),
                 "dist_std": self.dist_std_left.tolist(),
@@ -91,6 +100,9 @@ class CalibrationUncertainty:
             "rms_px": float(self.rms_px),
             "per_view_rms_px": self.per_view_rms_px.tolist(),
         }
+        if self.method:
+            out["method"] = self.method
+        return out
 
 
 def _std(data: dict[str, Any], key: str, size: int | None, source: str, prefix: str) -> np.ndarray:

@@ -56,42 +56,95 @@ class TargetSpec:
         return p.min(axis=0) - m, p.max(axis=0) + m
 
 
-def detect_target(gray: np.ndarray, spec: TargetSpec) -> tuple[np.ndarray | None, str]:
-    """Find the target's features (N, 2, pixels) or say why not.
+#: chessboard detectors, tried in this order until one finds the board: OpenCV's classic
+#: detector with its fast pre-check (cheap rejection of images without a board), the classic
+#: detector without it (the pre-check rejects some real boards: uneven light, boards near the
+#: image border), and the sector-based detector ``findChessboardCornersSB`` (exhaustive).
+CHESSBOARD_DETECTORS = ("fast", "plain", "sb")
 
-    Returns ``(points, "")`` or ``(None, reason)`` where reason is "target not found",
-    "too few corners (k of n)" or "too blurred (edge width w px)".
+_CLASSIC = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
+_SB = cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY
+
+
+@dataclass(frozen=True)
+class TargetDetection:
+    """The outcome of :func:`find_target` on one image.
+
+    Attributes:
+        points: feature positions (N, 2, pixels) in :meth:`TargetSpec.object_points` order,
+            or ``None``.
+        reason: why not found ("" when found).
+        detector: which detector found it (``"fast"``, ``"plain"``, ``"sb"`` for chessboards,
+            ``"grid"`` or ``"clustering"`` for circle grids; "" when none did).
     """
-    img = (
+
+    points: np.ndarray | None
+    reason: str
+    detector: str = ""
+
+
+def to_gray8(gray: np.ndarray) -> np.ndarray:
+    """An 8-bit single-channel copy for OpenCV's detectors (8-bit kept, others rescaled)."""
+    return (
         gray
         if gray.dtype == np.uint8
         else cv2.normalize(gray, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
     )
+
+
+def detect_target(gray: np.ndarray, spec: TargetSpec) -> tuple[np.ndarray | None, str]:
+    """Find the target's features (N, 2, pixels) or say why not (see :func:`find_target`).
+
+    Returns ``(points, "")`` or ``(None, reason)`` where reason is "target not found",
+    "too few corners (k of n)" or "too blurred (edge width w px)".
+    """
+    det = find_target(gray, spec)
+    return det.points, det.reason
+
+
+def find_target(gray: np.ndarray, spec: TargetSpec) -> TargetDetection:
+    """Find the target with each detector in turn (:data:`CHESSBOARD_DETECTORS`), then check
+    the corner count and the sharpness of the image."""
+    img = to_gray8(gray)
     n = spec.cols * spec.rows
     if spec.kind == "chessboard":
-        flags = (
-            cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_FAST_CHECK
-        )
-        found, pts = cv2.findChessboardCorners(img, spec.pattern_size, flags=flags)
-        if not found or pts is None:
-            return None, "target not found"
-        if len(pts) < n:
-            return None, f"too few corners ({len(pts)} of {n})"
-        crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4)
-        pts = cv2.cornerSubPix(img, pts, (5, 5), (-1, -1), crit)
-        width = float(cv2.estimateChessboardSharpness(img, spec.pattern_size, pts)[0][0])
-        if width > 4.0:
-            return None, f"too blurred (edge width {width:.1f} px)"
-        return pts.reshape(-1, 2).astype(np.float64), ""
-    found, pts = cv2.findCirclesGrid(img, spec.pattern_size, flags=cv2.CALIB_CB_ASYMMETRIC_GRID)
-    if not found or pts is None:
-        return None, "target not found"
+        pts, detector = _find_chessboard(img, spec.pattern_size)
+    else:
+        pts, detector = _find_circles(img, spec.pattern_size)
+    if pts is None:
+        return TargetDetection(None, "target not found")
     if len(pts) < n:
-        return None, f"too few corners ({len(pts)} of {n})"
-    width = _edge_width(img, pts.reshape(-1, 2))
+        return TargetDetection(None, f"too few corners ({len(pts)} of {n})", detector)
+    pts = pts.reshape(-1, 2).astype(np.float32)
+    if spec.kind == "chessboard":
+        width = float(cv2.estimateChessboardSharpness(img, spec.pattern_size, pts)[0][0])
+    else:
+        width = _edge_width(img, pts)
     if width > 4.0:
-        return None, f"too blurred (edge width {width:.1f} px)"
-    return pts.reshape(-1, 2).astype(np.float64), ""
+        return TargetDetection(None, f"too blurred (edge width {width:.1f} px)", detector)
+    return TargetDetection(pts.astype(np.float64), "", detector)
+
+
+def _find_chessboard(img: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray | None, str]:
+    crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4)
+    for detector, flags in (("fast", _CLASSIC | cv2.CALIB_CB_FAST_CHECK), ("plain", _CLASSIC)):
+        found, pts = cv2.findChessboardCorners(img, size, flags=flags)
+        if found and pts is not None:
+            return cv2.cornerSubPix(img, pts, (5, 5), (-1, -1), crit), detector
+    # the SB detector's corners are already sub-pixel (CALIB_CB_ACCURACY)
+    found, pts = cv2.findChessboardCornersSB(img, size, flags=_SB)
+    if found and pts is not None:
+        return pts, "sb"
+    return None, ""
+
+
+def _find_circles(img: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray | None, str]:
+    asym = cv2.CALIB_CB_ASYMMETRIC_GRID
+    for detector, flags in (("grid", asym), ("clustering", asym | cv2.CALIB_CB_CLUSTERING)):
+        found, pts = cv2.findCirclesGrid(img, size, flags=flags)
+        if found and pts is not None:
+            return pts, detector
+    return None, ""
 
 
 def _edge_width(img: np.ndarray, pts: np.ndarray) -> float:

@@ -29,15 +29,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``measure`` subcommand."""
     p = sub.add_parser(
         "measure",
-        help="measure one hole from a stereo image pair",
+        help="measure one hole from a stereo image pair (or many: --pairs)",
         description=(
             "Reads LEFT and RIGHT images (8- or 16-bit PNG/TIFF) and the stereo calibration "
             "(stereo.json); prints the hole's centre, axis and diameter in the left camera "
-            "frame. Writes nothing."
+            "frame. Writes nothing. With --pairs DIR|LIST instead of LEFT RIGHT: every pair "
+            "of a folder (left/ and right/ subfolders with the same file names, or names "
+            "starting or ending with left/right: H01_left.png + H01_right.png, left01.jpg + "
+            "right01.jpg) or of a list file (LEFT RIGHT [ID] per line, # comments) in one "
+            "process, with a progress bar; a pair that fails is reported in its row "
+            "(exit code 1) and the batch goes on; -o writes one row per pair (.csv or .json)."
         ),
     )
-    p.add_argument("left", help="left camera image")
-    p.add_argument("right", help="right camera image")
+    p.add_argument("left", nargs="?", help="left camera image")
+    p.add_argument("right", nargs="?", help="right camera image")
+    p.add_argument("--pairs", metavar="DIR|LIST", help="measure every pair of a folder or list")
+    p.add_argument("-o", "--output", help="with --pairs: write the rows to FILE (.csv or .json)")
     p.add_argument("--stereo", required=True, help="stereo calibration file (stereo.json)")
     p.add_argument("--diameter", type=float, default=None, help="expected diameter (metres)")
     p.add_argument(
@@ -48,6 +55,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=run)
+
+
+def _batch(args: argparse.Namespace) -> int:
+    if args.pairs is None or args.left is not None:
+        raise ImageError("pair", "--pairs DIR|LIST replaces LEFT RIGHT; -o needs --pairs")
+    from cell.commands.measure_batch import run_batch
+
+    return run_batch(args)
 
 
 def _table(m) -> str:
@@ -68,6 +83,10 @@ def _table(m) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Handler: measure and print; with ``--json`` errors are JSON too (exit code 2)."""
+    if args.pairs is not None or args.output is not None:
+        return _batch(args)
+    if args.left is None or args.right is None:
+        raise ImageError("pair", "give LEFT and RIGHT images, or --pairs DIR|LIST")
     opts = MeasureOptions.published() if args.method == "published" else MeasureOptions()
     try:
         stereo = StereoCalibration.load(args.stereo)
