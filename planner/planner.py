@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from planner.edge_check import BatchEdgeChecker
 from planner.errors import (
     NoReachableHoleError,
     StartConfigurationError,
@@ -28,6 +29,7 @@ from planner.errors import (
 from planner.options import Options
 from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
+from planner.roadmap import Roadmap, build_roadmap, detour_costs
 from planner.segments import Segment, SegmentCache
 from planner.sequence import GtspSequencer, SequenceResult
 from planner.timing import JointLimits, TimedMotion
@@ -49,9 +51,6 @@ LAZY_ROUNDS = 20
 LAZY_BUDGET_SHARE = 0.5
 #: lazy edge checks are this many times coarser than the set motion resolution
 LAZY_COARSENESS = 3.0
-#: estimated duration of a colliding straight edge until its detour is measured: factor, extra s
-DETOUR_FACTOR = 1.5
-DETOUR_EXTRA_S = 0.3
 
 
 def _no_progress(stage: str, done: int, total: int) -> None:
@@ -156,15 +155,41 @@ class TourPlanner:
         )
 
     def _segments(
-        self, home: NDArray[np.float64], route: _Route, cache: SegmentCache
+        self,
+        home: NDArray[np.float64],
+        route: _Route,
+        cache: SegmentCache,
+        seqr: GtspSequencer | None = None,
+        nodes: list[int] | None = None,
     ) -> list[Segment]:
         points = [home, *route.q, home]
         names = ["home", *route.hole_ids, "home"]
+        path = [0, *nodes, 0] if seqr is not None and nodes is not None else None
         out = []
         for k in range(len(points) - 1):
-            out.append(cache.get(points[k], points[k + 1], (names[k], names[k + 1])))
+            via = None
+            if path is not None:
+                hops = self._roadmap.via(path[k], path[k + 1])
+                via = None if not hops else seqr.nodes[hops]
+            out.append(cache.get(points[k], points[k + 1], (names[k], names[k + 1]), via))
             self.progress("paths", k + 1, len(points) - 1)
         return out
+
+    def _build_roadmap(self, seqr: GtspSequencer, checker: MotionChecker) -> None:
+        """Batch-check the motions between near nodes; colliding ones cost their detour."""
+        k = self.options.roadmap_neighbours
+        self._roadmap = Roadmap()
+        if k <= 0:
+            return
+        batch = BatchEdgeChecker(checker.coarser(LAZY_COARSENESS))
+        self._roadmap = build_roadmap(seqr.nodes, seqr.G, seqr.owner, batch, k)
+        checker.checks += batch.checks
+        blocked = []
+        for (u, v), free in self._roadmap.free.items():
+            self._edge_free[(u, v)] = free
+            if not free:
+                blocked += [(u, v), (v, u)]
+        seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
 
     def _avoid_colliding_edges(
         self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker, n_holes: int
@@ -178,18 +203,18 @@ class TourPlanner:
             if time.perf_counter() - started > LAZY_BUDGET_SHARE * o.budget_s(n_holes):
                 break
             path = [0, *(res.nodes or []), 0]
-            penalties = {}
+            blocked: list[tuple[int, int]] = []
             for u, v in itertools.pairwise(path):
                 key = (min(u, v), max(u, v))
                 if key not in self._edge_free:
                     self._edge_free[key] = coarse.segment_free(seqr.nodes[u], seqr.nodes[v])
                 if not self._edge_free[key] and (u, v) not in seqr.learned:
-                    penalties[(u, v)] = DETOUR_FACTOR * seqr.G[u, v] + DETOUR_EXTRA_S
+                    blocked.append((u, v))
             checker.checks += coarse.checks
             coarse.checks = 0
-            if not penalties:
+            if not blocked:
                 break
-            seqr.learn(penalties)
+            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
             budget = o.budget_s(n_holes) * REFINE_SHARE
             res = seqr.solve(budget, o.seed + 100 + k, o.effort, warm=res.nodes, repair=True)
         return res
@@ -207,11 +232,13 @@ class TourPlanner:
         t = time.perf_counter()
         self.progress("sequence", 0, 1)
         self._edge_free: dict[tuple[int, int], bool] = {}
+        self._roadmap = Roadmap()
         if self.sequencer is not None:
             res = self.sequencer(home, cands, limits)
             seqr = None
         else:
             seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
+            self._build_roadmap(seqr, cache.checker)
             res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort)
             res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
         self.progress("sequence", 1, 1)
@@ -220,7 +247,7 @@ class TourPlanner:
         measured_pairs: set[tuple[int, int]] = set()
         while True:
             route = self._route(cands, res)
-            segments = self._segments(home, route, cache)
+            segments = self._segments(home, route, cache, seqr, res.nodes)
             if seqr is None or res.nodes is None or rounds >= o.refine_rounds:
                 return route, segments, res, rounds
             path_nodes = [0, *res.nodes, 0]
@@ -302,7 +329,10 @@ class TourPlanner:
             "sequence_cost_s": seq.cost_s,
             "sequence_hit_time_limit": seq.hit_time_limit,
             "refine_rounds_used": rounds,
-            "ompl_segments": sum(s.path.planned for s in segments),
+            "ompl_segments": sum(s.path.planned and not s.path.via_roadmap for s in segments),
+            "roadmap_segments": sum(s.path.via_roadmap for s in segments),
+            "roadmap_edges_checked": self._roadmap.checked,
+            "roadmap_edges_blocked": sum(not f for f in self._roadmap.free.values()),
             "collision_checks": checker.checks,
         }
         return Tour(
