@@ -17,6 +17,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "cell_show",
     "thermal_cmd",
     "plan_cmd",
+    "plan_batch_cmd",
     "measure_cmd",
     "calibrate_cmd",
     "run_cmd",

@@ -90,3 +90,21 @@ class TourCellMismatchError(PlanningError):
             f"the tour does not belong to this cell: {field} is {tour_value!r} in the tour, "
             f"{cell_value!r} in the cell; plan the tour again for this cell"
         )
+
+
+class EngineError(PlanningError):
+    """The engine that runs independent starts is unusable (e.g. Ray not installed, no cluster
+    at the address). ``engine`` names it."""
+
+    def __init__(self, engine: str, reason: str) -> None:
+        self.engine = engine
+        self.reason = reason
+        super().__init__(f"{engine}: {reason}")
+
+
+class StartsFailedError(PlanningError):
+    """Every independent start failed; ``messages`` holds each start's error message."""
+
+    def __init__(self, messages: list[str]) -> None:
+        self.messages = list(messages)
+        super().__init__(self.messages[0] if self.messages else "no start was run")

@@ -24,8 +24,13 @@ class Options:
         effort: work of the search relative to the default (iterations and patience scale with it).
         nodes_per_hole: candidate configurations per hole the search works with (the final
             choice of configuration for the found order considers every candidate).
-        sequencer: ``"lns"`` (large-neighbourhood search, default) or ``"ortools"``
+        sequencer: ``"lns"`` (large-neighbourhood search, default), ``"pyvrp"`` (PyVRP,
+            one optional client per candidate, one required group per hole) or ``"ortools"``
             (OR-Tools routing with one disjunction per hole).
+        roadmap_neighbours: before the first solve, check the straight motions from every
+            candidate node to this many nearest nodes of other holes in one batch; colliding
+            ones cost their shortest detour through the free ones (:mod:`planner.roadmap`).
+            0 turns the roadmap off (only the lazy checks of the tour's edges remain).
     Paths:
         joint_step_deg: collision checks along a motion at least every this joint change (deg).
         tcp_step_m: ... and at least every this TCP displacement (m).
@@ -48,6 +53,7 @@ class Options:
     effort: float = 1.0
     nodes_per_hole: int = 16
     sequencer: str = "lns"
+    roadmap_neighbours: int = 8
     joint_step_deg: float = 0.5
     tcp_step_m: float = 0.002
     segment_time_s: float = 2.0
@@ -79,8 +85,12 @@ class Options:
             raise OptionsError("refine_rounds", self.refine_rounds, "must be zero or positive")
         if self.nodes_per_hole < 1:
             raise OptionsError("nodes_per_hole", self.nodes_per_hole, "must be at least 1")
-        if self.sequencer not in ("lns", "ortools"):
-            raise OptionsError("sequencer", self.sequencer, "must be 'lns' or 'ortools'")
+        if self.sequencer not in ("lns", "pyvrp", "ortools"):
+            raise OptionsError("sequencer", self.sequencer, "must be 'lns', 'pyvrp' or 'ortools'")
+        if not isinstance(self.roadmap_neighbours, int) or self.roadmap_neighbours < 0:
+            raise OptionsError(
+                "roadmap_neighbours", self.roadmap_neighbours, "must be zero or a positive integer"
+            )
         if self.dwell_s < 0 or not math.isfinite(self.dwell_s):
             raise OptionsError("dwell_s", self.dwell_s, "must be zero or positive")
         if self.time_budget_s is not None and not self.time_budget_s > 0:

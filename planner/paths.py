@@ -133,10 +133,12 @@ class _MotionValidator(ob.MotionValidator):
 
 @dataclass(frozen=True)
 class SegmentPath:
-    """A collision-free joint path (m, dof) rad, straight between rows; ``planned`` if by OMPL."""
+    """A collision-free joint path (m, dof) rad, straight between rows; ``planned`` if not the
+    straight segment (by OMPL, or ``via_roadmap``: through roadmap configurations)."""
 
     waypoints: NDArray[np.float64]
     planned: bool
+    via_roadmap: bool = False
 
 
 class _Space:
@@ -190,7 +192,19 @@ class _Space:
 
 
 class SegmentPlanner:
-    """Straight segment when free, else RRT-Connect + shortcutting (see module docstring)."""
+    """Straight segment when free, else a given detour, else RRT-Connect + shortcutting."""
+
+    def _shortcut(self, Q: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Greedy shortcut of a free polyline: from each kept row, jump to the farthest row
+        that the straight motion reaches freely (the result stays free at the resolution)."""
+        keep, i = [0], 0
+        while i < len(Q) - 1:
+            j = len(Q) - 1
+            while j > i + 1 and not self.checker.segment_free(Q[i], Q[j]):
+                j -= 1
+            keep.append(j)
+            i = j
+        return Q[keep]
 
     def __init__(
         self, checker: MotionChecker, lower: NDArray[np.float64], upper: NDArray[np.float64]
@@ -205,10 +219,19 @@ class SegmentPlanner:
         q_b: NDArray[np.float64],
         time_s: float,
         names: tuple[str, str],
+        via: NDArray[np.float64] | None = None,
     ) -> SegmentPath:
-        """A free path ``q_a`` to ``q_b``, else :class:`SegmentPlanningError` naming ``names``."""
+        """A free path ``q_a`` to ``q_b``, else :class:`SegmentPlanningError` naming ``names``.
+
+        ``via`` (rows, rad): a detour through known free configurations, tried (validated at
+        the set resolution, shortcut where straight motions are free) before OMPL.
+        """
         if self.checker.segment_free(q_a, q_b):
             return SegmentPath(np.array([q_a, q_b]), planned=False)
+        if via is not None and len(via):
+            Q = np.vstack([q_a, via, q_b])
+            if self.checker.polyline_free(Q):
+                return SegmentPath(self._shortcut(Q), planned=True, via_roadmap=True)
         Q = self.coarse.solve(q_a, q_b, time_s)
         self.checker.checks += self.coarse.checker.checks
         self.coarse.checker.checks = 0

@@ -19,8 +19,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from planner.edge_check import BatchEdgeChecker
 from planner.errors import (
     NoReachableHoleError,
+    SegmentPlanningError,
     StartConfigurationError,
     TourCellMismatchError,
     UnreachableHoleError,
@@ -28,6 +30,7 @@ from planner.errors import (
 from planner.options import Options
 from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
+from planner.roadmap import Roadmap, build_roadmap, detour_costs
 from planner.segments import Segment, SegmentCache
 from planner.sequence import GtspSequencer, SequenceResult
 from planner.timing import JointLimits, TimedMotion
@@ -44,14 +47,17 @@ STAGES = ("viewpoints", "sequence", "paths", "timing")
 #: time cap of each repair search after costs changed, as a share of the sequencing budget
 REFINE_SHARE = 0.15
 #: at most this many lazy re-sequencing rounds ...
-LAZY_ROUNDS = 20
-#: ... and at most this share of the sequencing budget in time
-LAZY_BUDGET_SHARE = 0.5
-#: lazy edge checks are this many times coarser than the set motion resolution
-LAZY_COARSENESS = 3.0
-#: estimated duration of a colliding straight edge until its detour is measured: factor, extra s
-DETOUR_FACTOR = 1.5
-DETOUR_EXTRA_S = 0.3
+LAZY_ROUNDS = 60
+#: ... and a safety cap in time, as a multiple of the sequencing budget
+LAZY_BUDGET_SHARE = 3.0
+#: a motion OMPL could not plan costs this much (s) and the tour is re-sequenced, this many times
+UNSOLVED_COST_S = 1000.0
+MAX_UNSOLVED = 5
+#: roadmap edge checks are this many times coarser than the set motion resolution (they
+#: only prove collisions: a motion found free there is checked again at the set resolution
+#: when a tour uses it; lazy checks at 3× coarser missed 1 cm plates and thin posts on the
+#: cluttered cells and left those detours to OMPL's random state)
+ROADMAP_COARSENESS = 3.0
 
 
 def _no_progress(stage: str, done: int, total: int) -> None:
@@ -156,43 +162,89 @@ class TourPlanner:
         )
 
     def _segments(
-        self, home: NDArray[np.float64], route: _Route, cache: SegmentCache
+        self,
+        home: NDArray[np.float64],
+        route: _Route,
+        cache: SegmentCache,
+        seqr: GtspSequencer | None = None,
+        nodes: list[int] | None = None,
     ) -> list[Segment]:
         points = [home, *route.q, home]
         names = ["home", *route.hole_ids, "home"]
+        path = [0, *nodes, 0] if seqr is not None and nodes is not None else None
         out = []
         for k in range(len(points) - 1):
-            out.append(cache.get(points[k], points[k + 1], (names[k], names[k + 1])))
+            via = None
+            if path is not None:
+                hops = self._roadmap.via(path[k], path[k + 1])
+                via = None if not hops else seqr.nodes[hops]
+            try:
+                out.append(cache.get(points[k], points[k + 1], (names[k], names[k + 1]), via))
+            except SegmentPlanningError as exc:
+                exc.nodes = None if path is None else (path[k], path[k + 1])
+                raise
             self.progress("paths", k + 1, len(points) - 1)
         return out
+
+    def _build_roadmap(self, seqr: GtspSequencer, checker: MotionChecker) -> None:
+        """Batch-check the motions between near nodes (``ROADMAP_COARSENESS`` times coarser
+        than the set resolution); colliding ones cost their roadmap detour."""
+        k = self.options.roadmap_neighbours
+        self._roadmap = Roadmap()
+        self._batch = BatchEdgeChecker(checker)
+        if k <= 0:
+            return
+        coarse = BatchEdgeChecker(checker.coarser(ROADMAP_COARSENESS))
+        self._roadmap = build_roadmap(seqr.nodes, seqr.G, seqr.owner, coarse, k)
+        checker.checks += coarse.checks
+        blocked = []
+        for (u, v), free in self._roadmap.free.items():
+            if not free:  # a collision at a coarse sample is one at the set resolution too
+                self._edge_free[(u, v)] = False
+                blocked += [(u, v), (v, u)]
+        seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
 
     def _avoid_colliding_edges(
         self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker, n_holes: int
     ) -> SequenceResult:
-        """Lazy collision checking: penalise tour edges whose straight segment collides
-        (checked ``LAZY_COARSENESS`` times coarser than the set resolution), re-sequence."""
+        """Lazy collision checking: the tour's unchecked edges are checked in one batch at
+        the set resolution; colliding ones get their roadmap detour cost; re-sequence.
+
+        Stops after ``LAZY_ROUNDS`` rounds (work, not time: the same seed gives the same
+        tour); the time cap ``LAZY_BUDGET_SHARE`` × budget only binds on a crawling machine."""
         o = self.options
-        coarse = checker.coarser(LAZY_COARSENESS)
-        started = time.perf_counter()
-        for k in range(LAZY_ROUNDS):
-            if time.perf_counter() - started > LAZY_BUDGET_SHARE * o.budget_s(n_holes):
+        started = time.thread_time()
+        for k in range(LAZY_ROUNDS + 1):
+            blocked = self._blocked_on_tour(seqr, res, checker)
+            out_of_work = k == LAZY_ROUNDS
+            out_of_time = time.thread_time() - started > LAZY_BUDGET_SHARE * o.budget_s(n_holes)
+            if not blocked or out_of_work or out_of_time:
                 break
-            path = [0, *(res.nodes or []), 0]
-            penalties = {}
-            for u, v in itertools.pairwise(path):
-                key = (min(u, v), max(u, v))
-                if key not in self._edge_free:
-                    self._edge_free[key] = coarse.segment_free(seqr.nodes[u], seqr.nodes[v])
-                if not self._edge_free[key] and (u, v) not in seqr.learned:
-                    penalties[(u, v)] = DETOUR_FACTOR * seqr.G[u, v] + DETOUR_EXTRA_S
-            checker.checks += coarse.checks
-            coarse.checks = 0
-            if not penalties:
-                break
-            seqr.learn(penalties)
+            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
             budget = o.budget_s(n_holes) * REFINE_SHARE
             res = seqr.solve(budget, o.seed + 100 + k, o.effort, warm=res.nodes, repair=True)
+        self._lazy_rounds += k
         return res
+
+    def _blocked_on_tour(
+        self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker
+    ) -> list[tuple[int, int]]:
+        """Check the tour's unchecked edges (one batch, set resolution); the colliding ones
+        whose cost is not yet a detour's (in the direction travelled)."""
+        path = [0, *(res.nodes or []), 0]
+        keys = [(min(u, v), max(u, v)) for u, v in itertools.pairwise(path)]
+        todo = sorted({key for key in keys if key not in self._edge_free})
+        if todo:
+            e = np.array(todo)
+            free = self._batch.free(seqr.nodes[e[:, 0]], seqr.nodes[e[:, 1]])
+            self._edge_free.update(zip(todo, free.tolist(), strict=True))
+        checker.checks += self._batch.checks
+        self._batch.checks = 0
+        return [
+            (u, v)
+            for (u, v), key in zip(itertools.pairwise(path), keys, strict=True)
+            if not self._edge_free[key] and (u, v) not in seqr.learned
+        ]
 
     def _sequence_and_paths(
         self,
@@ -207,20 +259,37 @@ class TourPlanner:
         t = time.perf_counter()
         self.progress("sequence", 0, 1)
         self._edge_free: dict[tuple[int, int], bool] = {}
+        self._roadmap = Roadmap()
+        self._lazy_rounds = 0
         if self.sequencer is not None:
             res = self.sequencer(home, cands, limits)
             seqr = None
         else:
             seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
+            self._build_roadmap(seqr, cache.checker)
             res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort)
             res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
         self.progress("sequence", 1, 1)
         timings["sequence"] = time.perf_counter() - t
         rounds = 0
         measured_pairs: set[tuple[int, int]] = set()
+        unsolved = 0
         while True:
             route = self._route(cands, res)
-            segments = self._segments(home, route, cache)
+            try:
+                segments = self._segments(home, route, cache, seqr, res.nodes)
+            except SegmentPlanningError as exc:
+                pair = getattr(exc, "nodes", None)
+                if seqr is None or pair is None or unsolved >= MAX_UNSOLVED:
+                    raise
+                unsolved += 1  # avoid that motion: re-sequence around it
+                log.info("%s; re-sequencing without it", exc)
+                seqr.learn({pair: UNSOLVED_COST_S})
+                self._edge_free[(min(pair), max(pair))] = False
+                budget = o.budget_s(len(cands)) * REFINE_SHARE
+                res = seqr.solve(budget, o.seed + 200 + unsolved, o.effort, res.nodes, True)
+                res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
+                continue
             if seqr is None or res.nodes is None or rounds >= o.refine_rounds:
                 return route, segments, res, rounds
             path_nodes = [0, *res.nodes, 0]
@@ -238,6 +307,7 @@ class TourPlanner:
             seqr.learn(measured)
             budget = o.budget_s(len(cands)) * REFINE_SHARE
             new = seqr.solve(budget, o.seed + rounds, o.effort, warm=res.nodes, repair=True)
+            new = self._avoid_colliding_edges(seqr, new, cache.checker, len(cands))
             timings["sequence"] += time.perf_counter() - t
             if new.nodes == res.nodes:
                 return route, segments, new, rounds
@@ -302,7 +372,11 @@ class TourPlanner:
             "sequence_cost_s": seq.cost_s,
             "sequence_hit_time_limit": seq.hit_time_limit,
             "refine_rounds_used": rounds,
-            "ompl_segments": sum(s.path.planned for s in segments),
+            "ompl_segments": sum(s.path.planned and not s.path.via_roadmap for s in segments),
+            "roadmap_segments": sum(s.path.via_roadmap for s in segments),
+            "roadmap_edges_checked": self._roadmap.checked,
+            "lazy_rounds": self._lazy_rounds,
+            "roadmap_edges_blocked": sum(not f for f in self._roadmap.free.values()),
             "collision_checks": checker.checks,
         }
         return Tour(

@@ -56,14 +56,21 @@ class SegmentCache:
         return through_waypoints(path.waypoints, self.limits, stops)
 
     def get(
-        self, q_a: NDArray[np.float64], q_b: NDArray[np.float64], names: tuple[str, str]
+        self,
+        q_a: NDArray[np.float64],
+        q_b: NDArray[np.float64],
+        names: tuple[str, str],
+        via: NDArray[np.float64] | None = None,
     ) -> Segment:
-        """The segment ``q_a`` to ``q_b`` (rad); :class:`SegmentPlanningError` if unsolvable."""
+        """The segment ``q_a`` to ``q_b`` (rad); :class:`SegmentPlanningError` if unsolvable.
+
+        ``via``: intermediate configurations of a roadmap detour, tried before OMPL.
+        """
 
         key = np.concatenate([q_a, q_b]).tobytes()
         if key not in self.cache:
             t = time.perf_counter()
-            path = self.planner.plan(q_a, q_b, self.segment_time_s, names)
+            path = self.planner.plan(q_a, q_b, self.segment_time_s, names, via)
             self.path_time_s += time.perf_counter() - t
             t = time.perf_counter()
             self.cache[key] = Segment(path, self._time(path))

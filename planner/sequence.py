@@ -28,10 +28,15 @@ from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 from planner.costs import CostTable, cost_matrix, travel_time
 from planner.errors import PlanningError
 from planner.lns import GtspLns, LnsSettings
+from planner.pyvrp_gtsp import solve_gtsp_pyvrp
 from planner.timing import JointLimits
 
 #: integer cost units per second handed to OR-Tools (10 µs resolution)
 COST_SCALE = 1e5
+#: the sequencing methods
+SEQUENCERS = ("pyvrp", "lns", "ortools")
+#: PyVRP iterations: base + per hole (a full solve; a repair after costs changed: a fifth)
+PYVRP_ITERATIONS = (500, 20)
 
 
 @dataclass(frozen=True)
@@ -179,8 +184,10 @@ class GtspSequencer:
         method: str = "lns",
         max_nodes: int = 4000,
     ) -> None:
-        if method not in ("lns", "ortools"):
-            raise PlanningError(f"unknown sequencing method {method!r} (use 'lns' or 'ortools')")
+        if method not in SEQUENCERS:
+            raise PlanningError(
+                f"unknown sequencing method {method!r} (use one of {', '.join(SEQUENCERS)})"
+            )
         if not candidates or any(len(c) == 0 for c in candidates):
             raise PlanningError("the sequencer needs holes, each with a candidate configuration")
         self.method = method
@@ -244,6 +251,12 @@ class GtspSequencer:
             start = None if warm is None else [int(self.owner[v]) for v in warm]
             found = GtspLns(self.G, self.groups, seed).run(settings, start)
             visited, hit = found.nodes, found.hit_time_limit
+        elif self.method == "pyvrp":
+            base, per_hole = PYVRP_ITERATIONS
+            its = effort * (base + per_hole * n) * (0.2 if repair and warm is not None else 1.0)
+            visited, hit = solve_gtsp_pyvrp(
+                self.G, self.groups, int(its), time_budget_s, seed, warm
+            )
         else:
             limit = int(effort * (200 + 5 * n))
             visited, hit = solve_gtsp(self.G, self.groups, time_budget_s, limit, seed)

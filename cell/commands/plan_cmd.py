@@ -14,10 +14,14 @@ import time
 from pathlib import Path
 from typing import TextIO
 
+from cell.commands.argtypes import positive_int
 from cell.config import load_cell
 from cell.errors import CellError
 from planner import STAGES, Options, Tour, TourPlanner
+from planner.engines import Engine, make_engine
 from planner.errors import OptionsError
+from planner.multistart import DEFAULT_STARTS, plan_multistart
+from planner.sequence import SEQUENCERS
 
 
 class StageBars:
@@ -88,7 +92,38 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--dt", type=float, default=0.004, help="controller period in s")
     p.add_argument("--dwell", type=float, default=0.2, help="rest at each stop in s")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_engine_arguments(p)
     p.set_defaults(handler=run_plan)
+
+
+def add_engine_arguments(p: argparse.ArgumentParser) -> None:
+    """The multi-start and engine options shared by ``plan`` and ``plan-batch``."""
+    p.add_argument(
+        "--starts",
+        type=positive_int,
+        default=DEFAULT_STARTS,
+        help="independent starts (seeds SEED*N .. SEED*N+N-1), the best tour kept "
+        "(default: %(default)s; 1 plans in this process with per-stage progress bars)",
+    )
+    p.add_argument(
+        "--jobs",
+        type=positive_int,
+        default=None,
+        help="local processes running the starts (default: every core)",
+    )
+    p.add_argument(
+        "--ray",
+        metavar="ADDRESS",
+        default=None,
+        help="run the starts on the Ray cluster at ADDRESS ('local': a local Ray instance; "
+        "needs the [ray] extra)",
+    )
+    p.add_argument(
+        "--sequencer",
+        choices=SEQUENCERS,
+        default=Options().sequencer,
+        help="GTSP solver (default: %(default)s)",
+    )
 
 
 def _options(args: argparse.Namespace) -> Options:
@@ -100,7 +135,27 @@ def _options(args: argparse.Namespace) -> Options:
         time_budget_s=args.time_budget,
         dt=args.dt,
         dwell_s=args.dwell,
+        sequencer=args.sequencer,
     )
+
+
+def engine_for(args: argparse.Namespace) -> Engine | None:
+    """The engine of the starts, or None to plan a single start in this process."""
+    if args.ray is None and args.starts == 1:
+        return None
+    return make_engine(args.ray, args.jobs)
+
+
+def plan_cell(
+    cell: object, options: Options, args: argparse.Namespace, engine: Engine | None
+) -> Tour:
+    """Plan one cell: in this process (one start, stage bars) or multi-start on ``engine``."""
+    if engine is None:
+        progress = None if args.quiet else StageBars()
+        return TourPlanner(options, progress).plan(cell)
+    if not args.quiet:
+        print(f"planning {args.starts} start(s) on {engine.name} ...", file=sys.stderr)
+    return plan_multistart(cell, options, args.starts, engine)
 
 
 def summary(tour: Tour, path: Path) -> list[str]:
@@ -119,6 +174,16 @@ def summary(tour: Tour, path: Path) -> list[str]:
         f"{tour.settings.get('ompl_segments', 0)} segment(s) planned around obstacles",
         f"written       {path}",
     ]
+    if "start_cycle_times_s" in tour.settings:
+        times = ", ".join(
+            "failed" if c is None else f"{c:.2f}" for c in tour.settings["start_cycle_times_s"]
+        )
+        seeds = tour.settings["start_seeds"]
+        lines.insert(
+            -1,
+            f"starts        {len(seeds)} on {tour.settings['engine']}: cycle {times} s "
+            f"(seeds {seeds[0]}..{seeds[-1]}; kept seed {tour.settings['seed']})",
+        )
     return lines
 
 
@@ -134,8 +199,7 @@ def run_plan(args: argparse.Namespace) -> int:
     except OptionsError as exc:
         raise CellError(str(exc)) from exc
     cell = load_cell(args.cell)
-    progress = None if args.quiet else StageBars()
-    tour = TourPlanner(options, progress).plan(cell)
+    tour = plan_cell(cell, options, args, engine_for(args))
     gc.collect()  # free the OMPL objects now (their bindings complain if still alive at exit)
     tour.save(out)
     print("\n".join(summary(tour, out)))

@@ -23,7 +23,7 @@ def _cell_file(tmp_path: Path, extra: list[dict]) -> Path:
 def test_plan_writes_the_tour_and_a_summary(tmp_path: Path, capsys) -> None:
     cell = _cell_file(tmp_path, [])
     out = tmp_path / "tour.json"
-    assert main(["plan", str(cell), "-o", str(out), "--seed", "3", "--quiet"]) == 0
+    assert main(["plan", str(cell), "-o", str(out), "--seed", "3", "--quiet", "--starts", "1"]) == 0
     tour = load_tour(out)
     assert tour.cell_name == "cli-test-cell" and len(tour.stops) == 3
     assert tour.settings["seed"] == 3
@@ -35,10 +35,10 @@ def test_left_out_holes_exit_1_and_strict_exits_2(tmp_path: Path, capsys) -> Non
     far = {"id": "FAR", "position": [4.0, 0.0, 0.0], "normal": [0, 0, 1], "diameter": 0.01}
     cell = _cell_file(tmp_path, [far])
     out = tmp_path / "tour.json"
-    assert main(["plan", str(cell), "-o", str(out), "--quiet"]) == 1
+    assert main(["plan", str(cell), "-o", str(out), "--quiet", "--starts", "1"]) == 1
     assert "FAR: out of reach" in capsys.readouterr().out
     out.unlink()
-    assert main(["plan", str(cell), "-o", str(out), "--strict", "--quiet"]) == 2
+    assert main(["plan", str(cell), "-o", str(out), "--strict", "--quiet", "--starts", "1"]) == 2
     err = capsys.readouterr().err
     assert "FAR: out of reach" in err and "Traceback" not in err
     assert not out.exists()

@@ -80,7 +80,7 @@ def test_local_search_deltas_match_the_applied_moves() -> None:
     assert _path_cost(C, perm) <= _path_cost(C, ident)
 
 
-@pytest.mark.parametrize("method", ["lns", "ortools"])
+@pytest.mark.parametrize("method", ["lns", "pyvrp", "ortools"])
 def test_sequencers_find_the_brute_force_optimum_of_small_instances(method: str) -> None:
     for seed in (2, 3):
         cands = _instance(5, seed)

@@ -1,0 +1,114 @@
+"""A roadmap among the candidate configurations: obstacle-aware costs for the GTSP.
+
+Before the first solve, the straight motions between every node (home and each
+hole's candidate configurations) and its ``k`` nearest nodes of other holes (in
+rest-to-rest travel time) are checked in one batch (:class:`BatchEdgeChecker`).
+The free motions form a roadmap: its nodes are collision-free configurations that
+any tour may pass, its edges straight motions known to be free. A motion that
+collides gets, as its cost, the shortest path through the roadmap (Dijkstra over
+the free edges, weighted by rest-to-rest travel time: a detour with a stop at each
+intermediate configuration, an upper bound on the flown detour), and that path is
+kept as the segment's first path to try before OMPL. Colliding motions with no
+roadmap path keep the estimate ``DETOUR_FACTOR × straight + DETOUR_EXTRA_S``.
+
+Everything here is deterministic: the costs the sequencer sees, and the detours it
+is offered, do not depend on the seed or on which edges a random search visited.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from planner.edge_check import BatchEdgeChecker
+
+#: estimated duration of a colliding straight motion without a roadmap detour: factor, extra s
+DETOUR_FACTOR = 1.5
+DETOUR_EXTRA_S = 0.3
+
+
+@dataclass
+class Roadmap:
+    """Checked motions between candidate nodes and the detours through the free ones."""
+
+    free: dict[tuple[int, int], bool] = field(default_factory=dict)
+    detours: dict[tuple[int, int], list[int]] = field(default_factory=dict)
+    checked: int = 0
+
+    def via(self, u: int, v: int) -> list[int] | None:
+        """Intermediate nodes of the roadmap detour from ``u`` to ``v`` (None: none known)."""
+        path = self.detours.get((u, v))
+        if path is None and (v, u) in self.detours:
+            path = self.detours[(v, u)][::-1]
+        return path
+
+
+def neighbour_pairs(G: NDArray[np.float64], owner: NDArray[np.int64], k: int) -> np.ndarray:
+    """Undirected pairs (u < v) joining each node to its ``k`` nearest nodes of other holes."""
+    N = G.shape[0]
+    D = np.minimum(G, G.T).astype(float)
+    D[owner[:, None] == owner[None, :]] = np.inf  # same hole (and home with itself)
+    k = min(k, N - 1)
+    near = np.argpartition(D, k - 1, axis=1)[:, :k] if k > 0 else np.zeros((N, 0), int)
+    u = np.repeat(np.arange(N), near.shape[1])
+    v = near.ravel()
+    ok = np.isfinite(D[u, v])
+    pairs = np.unique(np.sort(np.column_stack([u[ok], v[ok]]), axis=1), axis=0)
+    return pairs
+
+
+def build_roadmap(
+    nodes: NDArray[np.float64],
+    G: NDArray[np.float64],
+    owner: NDArray[np.int64],
+    checker: BatchEdgeChecker,
+    k: int,
+) -> Roadmap:
+    """Check the ``k``-nearest motions of every node in one batch (see module docstring)."""
+    pairs = neighbour_pairs(G, owner, k)
+    rm = Roadmap()
+    if not len(pairs):
+        return rm
+    ok = checker.free(nodes[pairs[:, 0]], nodes[pairs[:, 1]])
+    rm.checked = len(pairs)
+    for (u, v), f in zip(pairs.tolist(), ok.tolist(), strict=True):
+        rm.free[(u, v)] = f
+    return rm
+
+
+def detour_costs(
+    rm: Roadmap, G: NDArray[np.float64], blocked: list[tuple[int, int]]
+) -> dict[tuple[int, int], float]:
+    """Costs (s) of the ``blocked`` motions: shortest roadmap path, else the estimate.
+
+    Records each detour's intermediate nodes in ``rm.detours``.
+    """
+    if not blocked:
+        return {}
+    N = G.shape[0]
+    free = [(u, v) for (u, v), f in rm.free.items() if f]
+    out: dict[tuple[int, int], float] = {}
+    sources = sorted({u for u, _ in blocked})
+    dist = pred = None
+    if free:
+        e = np.array(free)
+        w = np.maximum(G[e[:, 0], e[:, 1]], 1e-9)
+        graph = csr_matrix((w, (e[:, 0], e[:, 1])), shape=(N, N))
+        dist, pred = dijkstra(graph, directed=False, indices=sources, return_predecessors=True)
+    row = {s: i for i, s in enumerate(sources)}
+    for u, v in blocked:
+        estimate = DETOUR_FACTOR * G[u, v] + DETOUR_EXTRA_S
+        if dist is not None and np.isfinite(dist[row[u], v]):
+            path, x = [], v
+            while x != u:
+                x = int(pred[row[u], x])
+                path.append(x)
+            rm.detours[(u, v)] = path[::-1][1:]
+            out[(u, v)] = max(float(dist[row[u], v]), float(G[u, v]))
+        else:
+            out[(u, v)] = estimate
+    return out
