@@ -42,6 +42,8 @@ def _summary(cfg: CellConfig) -> list[str]:
         "          limits  vel " + " ".join(f"{v:.2f}" for v in arm.velocity_limit) + " rad/s",
         f"tool      tcp {cfg.tool.tool0_to_tcp.xyz} from tool0, standoff {cfg.tool.standoff_m} m, "
         f"{len(cfg.tool.shapes)} shapes",
+        f"clearance arm {cfg.robot.clearance_m * 1e3:g} mm, tool {cfg.tool.clearance_m * 1e3:g} mm "
+        "(to obstacles; the tool's also to the arm)",
         f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes, "
         f"{len(cfg.part.obstacles)} obstacles",
         f"cell      {len(cfg.environment.obstacles)} environment obstacles, "
@@ -49,7 +51,7 @@ def _summary(cfg: CellConfig) -> list[str]:
     ]
     if arm.collision.excluded_pairs:
         lines.append(
-            f"note      pairs touching at q=0, not checked: {arm.collision.excluded_pairs}"
+            f"note      bodies touching at q=0, not checked: {arm.collision.excluded_pairs}"
         )
     return lines
 
