@@ -77,6 +77,8 @@ def run_show(args: argparse.Namespace) -> int:
         note = "" if r.reachable else f"UNREACHABLE: {r.reason}"
         if r.reachable and r.rolls_free < r.n_rolls // 4:
             note = "hard: few rolls usable"
+        if r.reachable and r.tilt_deg > 0:
+            note = f"tilted: no free view along the axis, free {r.tilt_deg:g} deg off it"
         print(
             f"{hid:8s} {diameter * 1e3:8.1f} {r.n_solutions:8d} {r.n_free:6d} "
             f"{r.rolls_free:4d}/{r.n_rolls:<4d}  {note}"
