@@ -18,7 +18,9 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator
 
+from cell.config_mesh import MeshSpec
 from cell.errors import ConfigError
+from cell.holes_csv import read_holes_csv
 from cell.uncertainty.materials import (
     BUILTIN_MATERIALS,
     DEFAULT_MATERIAL,
@@ -27,6 +29,7 @@ from cell.uncertainty.materials import (
     material_field,
 )
 from robots import DEFAULT_MODEL, Arm, LimitScaling, LimitsError, RobotModelError, Shape
+from robots.meshes import MeshFileError
 from robots.transforms import pose_to_matrix
 
 DATA_DIR = Path(__file__).parent / "data"
@@ -90,29 +93,35 @@ class Sphere(_Strict):
     radius: Positive
 
 
+SHAPE_KINDS = ("box", "cylinder", "capsule", "sphere", "mesh")
+
+
 class ShapeSpec(_Strict):
-    """One primitive: exactly one of ``box``, ``cylinder``, ``capsule``, ``sphere``, with a pose."""
+    """One shape with a pose: exactly one of ``box``, ``cylinder``, ``capsule``, ``sphere``,
+    ``mesh`` (:mod:`cell.config_mesh`)."""
 
     box: Box | None = None
     cylinder: Cylinder | None = None
     capsule: Cylinder | None = None
     sphere: Sphere | None = None
+    mesh: MeshSpec | None = None
     pose: Pose = IDENTITY
     name: str | None = None
 
     def model_post_init(self, __context: Any) -> None:
-        kinds = [
-            k for k in ("box", "cylinder", "capsule", "sphere") if getattr(self, k) is not None
-        ]
+        kinds = [k for k in SHAPE_KINDS if getattr(self, k) is not None]
         if len(kinds) != 1:
-            raise ValueError(
-                f"a shape needs exactly one of box, cylinder, capsule, sphere (got {kinds})"
-            )
+            raise ValueError(f"a shape needs exactly one of {', '.join(SHAPE_KINDS)} (got {kinds})")
 
-    def to_shape(self, T_parent: np.ndarray, default_name: str) -> Shape:
-        """The :class:`robots.Shape`, its pose premultiplied by ``T_parent``."""
+    def to_shape(
+        self, T_parent: np.ndarray, default_name: str, base_dir: Path | None = None
+    ) -> Shape:
+        """The :class:`robots.Shape`, its pose premultiplied by ``T_parent``; a mesh path is
+        taken relative to ``base_dir``."""
         name = self.name or default_name
         T = T_parent @ self.pose.matrix()
+        if self.mesh is not None:
+            return Shape("mesh", (), T, name, self.mesh.load(base_dir))
         if self.box is not None:
             return Shape("box", tuple(self.box.size), T, name)
         if self.sphere is not None:
@@ -142,6 +151,8 @@ class Robot(_Strict):
     package_paths: list[str] = []
     #: ISO 9283 pose repeatability RP (m); None: the maker's figure for the model
     repeatability_m: Annotated[float, Field(gt=0, le=1e-3)] | None = None
+    #: margin kept between every arm link and every obstacle (m)
+    clearance_m: Annotated[float, Field(ge=0, le=0.5)] = 0.010
 
 
 class Tool(_Strict):
@@ -149,6 +160,8 @@ class Tool(_Strict):
     standoff_m: Positive
     shapes: list[ShapeSpec] = []
     calibration: str | None = None
+    #: margin kept between the tool and every obstacle or arm link (m)
+    clearance_m: Annotated[float, Field(ge=0, le=0.5)] = 0.005
 
 
 class Hole(_Strict):
@@ -168,6 +181,8 @@ PART_TEMPERATURE_RANGE_C = (-10.0, 50.0)
 class Part(_Strict):
     base: Pose = IDENTITY
     holes: list[Hole] = []
+    #: more holes from a CSV, relative to the cell file (:mod:`cell.holes_csv`)
+    holes_csv: str | None = None
     obstacles: list[ShapeSpec] = []
     #: a built-in name or {name, alpha_per_K, u_alpha_per_K}; None: steel assumed
     material: MaterialSpec | None = None
@@ -259,15 +274,23 @@ class CellConfig(_Strict):
             for h in self.part.holes
         ]
 
+    @property
+    def base_dir(self) -> Path | None:
+        """The cell file's folder (relative paths in the file start here)."""
+        return None if self._source_path is None else self._source_path.parent
+
     def tool_shapes(self) -> list[Shape]:
         """The stereo head's shapes, poses relative to ``tool0``."""
-        return [s.to_shape(np.eye(4), f"tool{i}") for i, s in enumerate(self.tool.shapes)]
+        d = self.base_dir
+        return [s.to_shape(np.eye(4), f"tool{i}", d) for i, s in enumerate(self.tool.shapes)]
 
     def obstacle_shapes(self) -> list[Shape]:
         """Part and environment obstacles, poses in the cell frame."""
-        T_part = self.T_cell_part()
-        part = [s.to_shape(T_part, f"part{i}") for i, s in enumerate(self.part.obstacles)]
-        env = [s.to_shape(np.eye(4), f"env{i}") for i, s in enumerate(self.environment.obstacles)]
+        T_part, d = self.T_cell_part(), self.base_dir
+        part = [s.to_shape(T_part, f"part{i}", d) for i, s in enumerate(self.part.obstacles)]
+        env = [
+            s.to_shape(np.eye(4), f"env{i}", d) for i, s in enumerate(self.environment.obstacles)
+        ]
         return part + env
 
     def _relative_to_cell(self, path: str) -> Path:
@@ -302,6 +325,7 @@ class CellConfig(_Strict):
         arm = self.build_robot()
         arm.set_tool(self.T_tool0_tcp(), self.tool_shapes())
         arm.add_obstacles(self.obstacle_shapes())
+        arm.set_clearance(self.robot.clearance_m, self.tool.clearance_m)
         return arm
 
     def part_material(self) -> tuple[Material, bool]:
@@ -364,6 +388,24 @@ def _part_temperature_problems(cfg: CellConfig) -> list[tuple[str, object, str]]
     return []
 
 
+def _mesh_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
+    problems = []
+    for group, shapes in (
+        ("tool.shapes", cfg.tool.shapes),
+        ("part.obstacles", cfg.part.obstacles),
+        ("environment.obstacles", cfg.environment.obstacles),
+    ):
+        for i, spec in enumerate(shapes):
+            if spec.mesh is None:
+                continue
+            path = spec.mesh.resolved(cfg.base_dir)
+            try:
+                spec.mesh.load(cfg.base_dir)
+            except MeshFileError as exc:
+                problems.append((f"{group}[{i}].mesh.path", str(path), exc.reason))
+    return problems
+
+
 def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
     try:
         arm = cfg.build_arm()
@@ -389,6 +431,25 @@ def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
     return []
 
 
+def _with_csv_holes(
+    cfg: CellConfig, source: str, source_path: Path | None, text: str
+) -> CellConfig:
+    """The cell with the holes of ``part.holes_csv`` appended to ``part.holes``."""
+    csv_path = Path(cfg.part.holes_csv or "")
+    if not csv_path.is_absolute() and cfg.base_dir is not None:
+        csv_path = cfg.base_dir / csv_path
+    rows = read_holes_csv(csv_path)
+    try:
+        extra = [Hole.model_validate(r) for r in rows]
+    except ValidationError as exc:
+        raise ConfigError(str(csv_path), _pydantic_problems(exc)) from exc
+    part = cfg.part.model_copy(update={"holes": [*cfg.part.holes, *extra]})
+    out = cfg.model_copy(update={"part": part})
+    out._source_path = source_path
+    out._raw_text = text
+    return out
+
+
 def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = None) -> CellConfig:
     """Validate a cell file's YAML text; raises :class:`ConfigError` listing every problem."""
     try:
@@ -403,7 +464,13 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
         raise ConfigError(source, _pydantic_problems(exc)) from exc
     cfg._source_path = source_path
     cfg._raw_text = text
-    problems = _duplicate_ids(cfg) + _part_temperature_problems(cfg) or _robot_problems(cfg)
+    if cfg.part.holes_csv is not None:
+        cfg = _with_csv_holes(cfg, source, source_path, text)
+    problems = (
+        _duplicate_ids(cfg) + _part_temperature_problems(cfg)
+        or _mesh_problems(cfg)
+        or _robot_problems(cfg)
+    )
     if problems:
         raise ConfigError(source, problems)
     return cfg

@@ -17,6 +17,9 @@ class Options:
         roll_step_deg: sampling step of the roll about the view axis (deg).
         tilt_deg: half-angle of the tilt cone around the hole axis (deg); 0 = view along the axis.
         tilt_azimuths: directions sampled on the cone when ``tilt_deg > 0``.
+        fallback_tilt_deg: a hole with no collision-free view along its axis is tried again
+            with a tilt cone of this half-angle (deg; 0 = never); a view a few degrees off
+            the axis is what an operator does where the arm's wrist would touch the head.
         strict: raise :class:`~planner.errors.UnreachableHoleError` instead of leaving holes out.
     Sequencing:
         seed: seed of every random choice (sequencer and OMPL); the same seed gives the same tour.
@@ -47,6 +50,7 @@ class Options:
     roll_step_deg: float = 15.0
     tilt_deg: float = 0.0
     tilt_azimuths: int = 6
+    fallback_tilt_deg: float = 10.0
     strict: bool = False
     seed: int = 0
     time_budget_s: float | None = None
@@ -79,6 +83,8 @@ class Options:
             raise OptionsError("roll_step_deg", self.roll_step_deg, "must lie in (0, 360]")
         if not 0 <= self.tilt_deg < 90:
             raise OptionsError("tilt_deg", self.tilt_deg, "must lie in [0, 90)")
+        if not 0 <= self.fallback_tilt_deg < 90:
+            raise OptionsError("fallback_tilt_deg", self.fallback_tilt_deg, "must lie in [0, 90)")
         if self.tilt_azimuths < 1:
             raise OptionsError("tilt_azimuths", self.tilt_azimuths, "must be at least 1")
         if self.refine_rounds < 0:

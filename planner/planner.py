@@ -138,6 +138,20 @@ class TourPlanner:
             c = hole_candidates(
                 arm, hole, cell.tool.standoff_m, o.roll_step_deg, o.tilt_deg, o.tilt_azimuths
             )
+            if not c.ok and o.fallback_tilt_deg > o.tilt_deg:
+                tilted = hole_candidates(
+                    arm,
+                    hole,
+                    cell.tool.standoff_m,
+                    o.roll_step_deg,
+                    o.fallback_tilt_deg,
+                    o.tilt_azimuths,
+                )
+                if tilted.ok:
+                    log.info(
+                        "hole %s: viewed up to %g deg off its axis", hole.id, o.fallback_tilt_deg
+                    )
+                    c = tilted
             if c.ok:
                 found.append(c)
             else:

@@ -16,7 +16,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from robots.arm_kinematics import check_given_table, derive_kinematics
-from robots.collision import CollisionModel
+from robots.collision import Clearance, CollisionModel
 from robots.dh import DHTable, fk_dh
 from robots.errors import JointVectorError, UnknownModelError, UrdfError
 from robots.ik import IKResult, solve_opw
@@ -118,6 +118,7 @@ class Arm:
         self._frame_ids = {"tool0": self.model.getFrameId("tool0")}
         self._T_tool0_flange = self.loaded.T_tool0_flange
         self._collision: CollisionModel | None = None
+        self.clearance_margins = Clearance()
 
     @property
     def dh(self) -> DHTable:
@@ -139,13 +140,18 @@ class Arm:
         self.obstacles.extend(shapes)
         self._collision = None
 
+    def set_clearance(self, robot_m: float, tool_m: float) -> None:
+        """Margins (m) kept by every check: arm vs obstacles, tool vs obstacles and arm links."""
+        self.clearance_margins = Clearance(robot_m, tool_m)
+        self._collision = None
+
     @property
     def collision(self) -> CollisionModel:
         """The collision model (built on first use, rebuilt after tool or obstacle changes)."""
         if self._collision is None:
             in_base = [s.moved(self._T_base_cell) for s in self.obstacles]
             self._collision = CollisionModel(
-                self.model, self._robot_geoms, self.tool_shapes, in_base
+                self.model, self._robot_geoms, self.tool_shapes, in_base, self.clearance_margins
             )
         return self._collision
 

@@ -2,9 +2,21 @@
 
 Built on Pinocchio's :class:`GeometryModel` (coal underneath). Pairs checked:
 every two robot bodies that are not adjacent in the chain (the tool counts as
-a body on ``link_6``), and every robot body against every obstacle. Pairs of
-robot bodies already touching at q = 0 are design overlaps of the coarse
-shapes and are left out (reported in :attr:`CollisionModel.excluded_pairs`).
+a body on ``link_6``), and every robot body against every obstacle. Two robot
+bodies of which any shapes already touch at q = 0 are a design overlap (the
+wrist's link_6 turns inside link_4's fork, whose enclosing shapes are solid) and
+are not checked against each other at all (reported in
+:attr:`CollisionModel.excluded_pairs`, as MoveIt's "Default" disabled pairs).
+
+Clearance (:class:`Clearance`): a pair is "in collision" when its shapes come
+closer than the pair's margin, coal's ``CollisionRequest.security_margin``
+(exact distance test, no shape is grown): ``robot_m`` for an arm link against
+an obstacle, ``tool_m`` for the tool against an obstacle or against an arm
+link; arm links among themselves get none (their shapes already enclose the
+real castings, and their poses are exact kinematics, not a user's placement).
+Margins rather than inflated primitives, because a margin works the same for
+meshes (which cannot be inflated), differs per pair (tool, arm, self) on one
+shape, and keeps the q = 0 exclusion on the true shapes.
 
 Speed: coal's dynamic AABB tree (a Pinocchio broad-phase manager) culls the
 pairs whose boxes do not overlap; only the rest get the exact primitive test.
@@ -29,6 +41,30 @@ Array = NDArray[np.float64]
 
 #: bodies of the arm chain, in order; adjacent ones are never checked against each other
 CHAIN_BODIES: tuple[str, ...] = (*LINK_NAMES, "tool")
+
+
+@dataclass(frozen=True)
+class Clearance:
+    """Margins (m) kept between the arm and obstacles (``robot_m``) and the tool and
+    obstacles or arm links (``tool_m``); 0 means touching is the limit."""
+
+    robot_m: float = 0.0
+    tool_m: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("robot_m", "tool_m"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and 0.0 <= value <= 1.0):
+                raise ValueError(f"clearance {name} must be in [0, 1] m, got {value!r}")
+
+    def margin(self, body_a: str, body_b: str) -> float:
+        """The margin (m) of a pair of bodies (chain body names, ``tool`` or ``obstacle``)."""
+        bodies = {body_a, body_b}
+        if "tool" in bodies:
+            return self.tool_m
+        if "obstacle" in bodies:
+            return self.robot_m
+        return 0.0
 
 
 @dataclass(frozen=True)
@@ -62,6 +98,7 @@ class CollisionModel:
         geom_model: the arm's collision geometry (from its URDF).
         tool_shapes: tool primitives with poses relative to ``tool0``.
         obstacles: obstacle primitives with poses in the arm's base frame.
+        clearance: margins kept per pair (default: none).
     """
 
     def __init__(
@@ -70,8 +107,10 @@ class CollisionModel:
         geom_model: pin.GeometryModel,
         tool_shapes: list[Shape],
         obstacles: list[Shape],
+        clearance: Clearance | None = None,
     ) -> None:
         self.model = model
+        self.clearance_margins = clearance or Clearance()
         self.geom_model = geom_model.copy()
         tool0 = model.getFrameId("tool0")
         link6_joint = model.frames[tool0].parentJoint
@@ -113,12 +152,19 @@ class CollisionModel:
         self.geom_data = pin.GeometryData(self.geom_model)
         q0 = pin.neutral(self.model)
         pin.updateGeometryPlacements(self.model, self.data, self.geom_model, self.geom_data, q0)
-        drop = []
+        touching: set[tuple[str, str]] = set()
         for k, (i, j) in enumerate(candidates):
-            robot_pair = "obstacle" not in (self.infos[i].body, self.infos[j].body)
-            if robot_pair and pin.computeCollision(self.geom_model, self.geom_data, k):
-                drop.append(k)
-                self.excluded_pairs.append((self.infos[i].name, self.infos[j].name))
+            a, b = self.infos[i].body, self.infos[j].body
+            if "obstacle" not in (a, b) and pin.computeCollision(
+                self.geom_model, self.geom_data, k
+            ):
+                touching.add((a, b))
+        drop = [
+            k
+            for k, (i, j) in enumerate(candidates)
+            if (self.infos[i].body, self.infos[j].body) in touching
+        ]
+        self.excluded_pairs = sorted(touching)
         for k in reversed(drop):
             self.geom_model.removeCollisionPair(self.geom_model.collisionPairs[k])
         self.geom_data = pin.GeometryData(self.geom_model)
@@ -130,15 +176,18 @@ class CollisionModel:
     def _configure_requests(self) -> None:
         # coal 3.0 misses overlapping cylinders when contacts are off (GJK stops early):
         # ask for the contact (EPA runs only on overlap) and start from the default guess.
-        for req in self.geom_data.collisionRequests:
+        for pair, req in zip(
+            self.geom_model.collisionPairs, self.geom_data.collisionRequests, strict=True
+        ):
             req.enable_contact = True
             req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
-            req.security_margin = 0.0
+            a, b = self.infos[pair.first].body, self.infos[pair.second].body
+            req.security_margin = self.clearance_margins.margin(a, b)
         for req in self.geom_data.distanceRequests:
             req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
 
     def in_collision(self, q: Array) -> bool:
-        """True when any checked pair touches or overlaps at ``q`` (rad).
+        """True when any checked pair comes closer than its margin at ``q`` (rad).
 
         Uses coal's dynamic AABB tree to cull pairs, then exact primitive tests.
         """

@@ -1,12 +1,9 @@
 """Write the URDF of a built-in model from its figures (:mod:`robots.models`).
 
 The shipped files ``robots/urdf/<model>.urdf`` are this writer's output; a
-test keeps them equal. Collision geometry is coarse primitives that enclose
-each real link with a margin (URDF has no capsule: cylinders, spheres and
-boxes only). The lower arm (link_2) sits beside the plane of the forearm, as
-on ABB's arms whose J3 folds the forearm back past it. Shapes are laid out
-at q = 0, where every link frame is axis-aligned with ``base_link``, and
-shifted into their link frames.
+test keeps them equal. Collision geometry is boxes and cylinders per link
+(URDF has no capsule) fitted to enclose the ROS-Industrial collision meshes of
+the same arms (:mod:`robots.arm_shapes`, ``benchmarks/fit_link_shapes.py``).
 
 Run ``python -m robots.urdf_writer`` to rewrite the shipped files.
 """
@@ -18,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from robots.arm_shapes import LINK_PRIMITIVES
 from robots.models import JOINT_AXES, JOINT_NAMES, LINK_NAMES, MODELS, ArmSpec
 
 URDF_DIR = Path(__file__).parent / "urdf"
@@ -29,69 +27,20 @@ _AXIS_RPY = {"x": (0.0, np.pi / 2, 0.0), "y": (-np.pi / 2, 0.0, 0.0), "z": (0.0,
 
 @dataclass(frozen=True)
 class LinkShape:
-    """One primitive of a link, laid out at q = 0 in base coordinates (m)."""
+    """One primitive of a link, its centre in the link's own frame (m)."""
 
     link: str
     kind: str  # "box" | "cylinder" | "sphere"
     size: tuple[float, ...]  # box (x, y, z); cylinder (radius, length); sphere (radius,)
-    center_base_m: tuple[float, float, float]
+    center_link_m: tuple[float, float, float]
     axis: str = "z"  # cylinder axis
 
 
-def link_origins_at_zero(spec: ArmSpec) -> dict[str, np.ndarray]:
-    """Position of every link frame in ``base_link`` at q = 0 (m)."""
-    origins = {"base_link": np.zeros(3)}
-    p = np.zeros(3)
-    for link, offset in zip(LINK_NAMES[1:], spec.joint_origins_m, strict=True):
-        p = p + np.asarray(offset, dtype=float)
-        origins[link] = p
-    return origins
-
-
 def link_shapes(spec: ArmSpec) -> list[LinkShape]:
-    """The enclosing primitives of every link of a model (m)."""
-    s = spec.scale
-    o = link_origins_at_zero(spec)
-    a1, d1, a2, a3, d4, d6 = spec.a1, spec.d1, spec.a2, spec.a3, spec.d4, spec.d6
-    z_elbow = d1 + a2
-    z_fore = d1 + a2 + a3
-    x_j4 = o["link_4"][0]
-    x_fore0 = max(x_j4, a1 + 0.2 * s)  # the rotating forearm starts ahead of the elbow housing
-    x_wrist = a1 + d4
-    turret_top = d1 - 0.12 * s
+    """The enclosing primitives of every link of a model (:mod:`robots.arm_shapes`, m)."""
     return [
-        LinkShape("base_link", "box", (0.62 * s, 0.52 * s, 0.2 * s), (-0.04 * s, 0.0, 0.1 * s)),
-        LinkShape(
-            "link_1",
-            "cylinder",
-            (0.25 * s, turret_top - 0.2 * s),
-            (0.0, 0.0, 0.5 * (turret_top + 0.2 * s)),
-        ),
-        LinkShape(
-            "link_1",
-            "box",
-            (a1 + 0.34 * s, 0.62 * s, 0.26 * s),
-            (0.5 * a1 - 0.05 * s, -0.08 * s, d1),
-        ),
-        # the lower arm runs beside the arm plane, so the forearm folds past it (J3 to -180 deg)
-        LinkShape("link_2", "cylinder", (0.12 * s, a2 + 0.26 * s), (a1, -0.23 * s, d1 + 0.5 * a2)),
-        LinkShape(
-            "link_3",
-            "box",
-            (x_fore0 - a1 + 0.27 * s, 0.3 * s, a3 + 0.26 * s),
-            (0.5 * (a1 - 0.25 * s + x_fore0 + 0.02 * s), 0.0, 0.5 * (z_elbow + z_fore)),
-        ),
-        LinkShape(
-            "link_4",
-            "cylinder",
-            (0.09 * s, x_wrist - 0.1 * s - x_fore0),
-            (0.5 * (x_fore0 + x_wrist - 0.1 * s), 0.0, z_fore),
-            axis="x",
-        ),
-        LinkShape("link_5", "sphere", (0.1 * s,), (x_wrist, 0.0, z_fore)),
-        LinkShape(
-            "link_6", "cylinder", (0.05 * s, d6), (x_wrist + 0.5 * d6, 0.0, z_fore), axis="x"
-        ),
+        LinkShape(link, kind, size, xyz, axis)
+        for link, kind, size, xyz, axis in LINK_PRIMITIVES[spec.name]
     ]
 
 
@@ -107,10 +56,10 @@ def _geometry_xml(shape: LinkShape) -> str:
     return f'<sphere radius="{shape.size[0]:.6g}"/>'
 
 
-def _link_xml(link: str, shapes: list[LinkShape], origin: np.ndarray) -> list[str]:
+def _link_xml(link: str, shapes: list[LinkShape]) -> list[str]:
     lines = [f'  <link name="{link}">']
     for shape in shapes:
-        xyz = _fmt(np.asarray(shape.center_base_m) - origin)
+        xyz = _fmt(shape.center_link_m)
         rpy = _fmt(_AXIS_RPY[shape.axis] if shape.kind == "cylinder" else (0, 0, 0))
         geometry = _geometry_xml(shape)
         for tag in ("visual", "collision"):
@@ -130,7 +79,6 @@ def _link_xml(link: str, shapes: list[LinkShape], origin: np.ndarray) -> list[st
 
 def urdf_text(spec: ArmSpec) -> str:
     """The URDF document of a model."""
-    origins = link_origins_at_zero(spec)
     shapes = link_shapes(spec)
     lines = [
         '<?xml version="1.0"?>',
@@ -138,7 +86,7 @@ def urdf_text(spec: ArmSpec) -> str:
         f'<robot name="{spec.name}">',
     ]
     for link in LINK_NAMES:
-        lines += _link_xml(link, [s for s in shapes if s.link == link], origins[link])
+        lines += _link_xml(link, [s for s in shapes if s.link == link])
     lines += ['  <link name="base"/>', '  <link name="flange"/>', '  <link name="tool0"/>']
     for i, name in enumerate(JOINT_NAMES):
         lines += [

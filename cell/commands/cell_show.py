@@ -44,6 +44,8 @@ def _summary(cfg: CellConfig) -> list[str]:
         *_robot_lines(arm),
         f"tool      tcp {cfg.tool.tool0_to_tcp.xyz} from tool0, standoff {cfg.tool.standoff_m} m, "
         f"{len(cfg.tool.shapes)} shapes",
+        f"clearance arm {cfg.robot.clearance_m * 1e3:g} mm, tool {cfg.tool.clearance_m * 1e3:g} mm "
+        "(to obstacles; the tool's also to the arm)",
         f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes, "
         f"{len(cfg.part.obstacles)} obstacles",
         f"cell      {len(cfg.environment.obstacles)} environment obstacles, "
@@ -51,7 +53,7 @@ def _summary(cfg: CellConfig) -> list[str]:
     ]
     if arm.collision.excluded_pairs:
         lines.append(
-            f"note      pairs touching at q=0, not checked: {arm.collision.excluded_pairs}"
+            f"note      bodies touching at q=0, not checked: {arm.collision.excluded_pairs}"
         )
     return lines
 
@@ -92,6 +94,8 @@ def run_show(args: argparse.Namespace) -> int:
         note = "" if r.reachable else f"UNREACHABLE: {r.reason}"
         if r.reachable and r.rolls_free < r.n_rolls // 4:
             note = "hard: few rolls usable"
+        if r.reachable and r.tilt_deg > 0:
+            note = f"tilted: no free view along the axis, free {r.tilt_deg:g} deg off it"
         print(
             f"{hid:8s} {diameter * 1e3:8.1f} {r.n_solutions:8d} {r.n_free:6d} "
             f"{r.rolls_free:4d}/{r.n_rolls:<4d}  {note}"

@@ -89,6 +89,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--roll-step-deg", type=float, default=15.0, help="roll sampling about the view axis"
     )
     p.add_argument("--tilt-deg", type=float, default=0.0, help="half-angle of the view tilt cone")
+    p.add_argument(
+        "--fallback-tilt-deg",
+        type=float,
+        default=10.0,
+        help="tilt cone tried for a hole with no free view along its axis (0 = never)",
+    )
     p.add_argument("--dt", type=float, default=0.004, help="controller period in s")
     p.add_argument("--dwell", type=float, default=0.2, help="rest at each stop in s")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
@@ -130,6 +136,7 @@ def _options(args: argparse.Namespace) -> Options:
     return Options(
         roll_step_deg=args.roll_step_deg,
         tilt_deg=args.tilt_deg,
+        fallback_tilt_deg=args.fallback_tilt_deg,
         strict=args.strict,
         seed=args.seed,
         time_budget_s=args.time_budget,

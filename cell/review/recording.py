@@ -169,6 +169,11 @@ class Recorder:
                 quaternions=[quat],
                 colors=[150, 150, 150],
             )
+        elif s.mesh is not None:  # a CAD mesh obstacle, vertices moved into the view frame
+            v = s.mesh.vertices @ T[:3, :3].T + T[:3, 3]
+            arch = rr.Mesh3D(
+                vertex_positions=v, triangle_indices=s.mesh.faces, albedo_factor=[150, 150, 150]
+            )
         else:
             arch = rr.Ellipsoids3D(
                 half_sizes=[[s.size[0]] * 3], centers=[T[:3, 3]], colors=[150, 150, 150]

@@ -21,6 +21,7 @@ from planner import (
 )
 from planner.timing import JointLimits
 from planner.trajectory import finite_difference_limits
+from planner.viewpoints import hole_candidates
 
 #: finite differences of the sampled trajectory may exceed a limit by this fraction (rounding)
 LIMIT_TOL = 1e-6
@@ -62,7 +63,10 @@ def test_each_stop_puts_the_tcp_on_the_hole_axis_at_the_standoff(builtin) -> Non
         T = arm.fk(np.array(stop.q), "tcp")
         z = T[:3, 2]
         assert np.linalg.norm(T[:3, 3] + cell.tool.standoff_m * z - h.position_m) < 1e-6
-        assert z @ -h.normal == pytest.approx(1.0, abs=1e-9)
+        if z @ -h.normal != pytest.approx(1.0, abs=1e-9):
+            # off the axis only on the fallback cone, where no view along the axis is free
+            assert z @ -h.normal == pytest.approx(np.cos(np.radians(10.0)), abs=1e-9)
+            assert not hole_candidates(arm, h, cell.tool.standoff_m, 15.0).ok
         assert np.allclose(stop.tcp_pose["xyz"], T[:3, 3])
 
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from robots import MODELS, Arm, dh_table, fk_dh
+from robots.arm_shapes import LINK_PRIMITIVES
 from robots.urdf_writer import URDF_DIR, urdf_text
 
 NAMES = sorted(MODELS)
@@ -66,7 +67,9 @@ def test_collision_model_keeps_every_link_shape(name: str) -> None:
     bodies = [info.body for info in arm.collision.infos]
     for link in ("base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6"):
         assert link in bodies
-    assert bodies.count("link_1") == 2
+    for link in ("base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6"):
+        expected = sum(row[0] == link for row in LINK_PRIMITIVES[name])
+        assert bodies.count(link) == expected
 
 
 def test_tcp_frame_follows_the_tool_and_base() -> None:

@@ -1,0 +1,73 @@
+"""Triangle meshes for collision checks: read with trimesh, checked with coal BVH models.
+
+A :class:`TriangleMesh` holds vertices (m, in the mesh's own frame, scale applied) and
+triangles. STL, OBJ and PLY files are read; the mesh is used as given (no convex hull), so
+a hollow part keeps its holes and openings, which is what an inspection tool reaches into.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import coal
+import numpy as np
+from numpy.typing import NDArray
+
+from robots.errors import RobotModelError
+
+MESH_SUFFIXES = (".stl", ".obj", ".ply")
+
+
+class MeshFileError(RobotModelError):
+    """A mesh file is missing, unreadable or holds no triangles."""
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"{path}: {reason}")
+
+
+@dataclass(frozen=True, eq=False)
+class TriangleMesh:
+    """Vertices (N, 3) in metres and triangles (M, 3) as vertex indices."""
+
+    vertices: NDArray[np.float64]
+    faces: NDArray[np.int64]
+
+    def geometry(self) -> coal.BVHModelOBBRSS:
+        """The coal BVH model of this mesh (exact triangles, OBB-RSS tree)."""
+        bvh = coal.BVHModelOBBRSS()
+        bvh.beginModel(len(self.faces), len(self.vertices))
+        bvh.addVertices(np.ascontiguousarray(self.vertices, dtype=np.float64))
+        bvh.addTriangles(np.ascontiguousarray(self.faces, dtype=np.int64))
+        bvh.endModel()
+        return bvh
+
+    def bounding_radius(self) -> float:
+        """Radius (m) of a sphere about the mesh frame's origin that holds every vertex."""
+        return float(np.max(np.linalg.norm(self.vertices, axis=1)))
+
+
+def load_mesh(path: str | Path, scale: float = 1.0) -> TriangleMesh:
+    """Read an STL, OBJ or PLY file; vertices multiplied by ``scale`` (file units to m)."""
+    import trimesh  # imported here: only cells with mesh obstacles pay its import time
+
+    p = Path(path)
+    if p.suffix.lower() not in MESH_SUFFIXES:
+        raise MeshFileError(str(p), f"not a mesh file (one of {', '.join(MESH_SUFFIXES)})")
+    if not p.is_file():
+        raise MeshFileError(str(p), "no such file")
+    if not (np.isfinite(scale) and scale > 0):
+        raise MeshFileError(str(p), f"scale must be a positive number, got {scale!r}")
+    try:
+        mesh = trimesh.load(p, force="mesh", process=False)
+    except Exception as exc:  # trimesh raises many kinds on a corrupt file
+        raise MeshFileError(str(p), f"cannot be read as a mesh: {exc}") from exc
+    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
+    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    if len(faces) == 0 or len(vertices) < 3:
+        raise MeshFileError(str(p), "holds no triangles")
+    if not np.all(np.isfinite(vertices)):
+        raise MeshFileError(str(p), "has non-finite vertex coordinates")
+    return TriangleMesh(vertices * scale, faces)
