@@ -21,7 +21,6 @@ from robots.dh import DHTable, fk_dh
 from robots.errors import JointVectorError, UnknownModelError, UrdfError
 from robots.ik import IKResult, solve_opw
 from robots.limits import narrowed_limits
-from robots.opw import fk_opw
 from robots.models import (
     ACCEL_PER_SPEED,
     DEFAULT_MODEL,
@@ -29,6 +28,7 @@ from robots.models import (
     MODELS,
     ArmSpec,
 )
+from robots.opw import fk_opw
 from robots.shapes import Shape
 from robots.transforms import invert
 from robots.urdf_load import load_urdf
@@ -53,6 +53,8 @@ def urdf_path(model: str | Path) -> Path:
     if str(model) in MODELS:
         return URDF_DIR / f"{model}.urdf"
     path = Path(model)
+    if path.suffix == ".xacro":
+        raise UrdfError(str(path), "is a xacro file: expand it first (xacro arm.xacro > arm.urdf)")
     if path.suffix == ".urdf":
         if not path.is_file():
             raise UrdfError(str(path), "no such file")
