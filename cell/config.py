@@ -302,7 +302,9 @@ class CellConfig(_Strict):
     def robot_model(self) -> str:
         """``robot.model``: a built-in name, or its URDF path resolved against the cell's folder."""
         model = self.robot.model
-        return str(self._relative_to_cell(model).resolve()) if model.endswith(".urdf") else model
+        if model.endswith((".urdf", ".xacro")):
+            return str(self._relative_to_cell(model).resolve())
+        return model
 
     def package_paths(self) -> list[Path]:
         """``robot.package_paths`` resolved against the cell file's folder."""

@@ -53,6 +53,8 @@ def urdf_path(model: str | Path) -> Path:
     if str(model) in MODELS:
         return URDF_DIR / f"{model}.urdf"
     path = Path(model)
+    if path.suffix == ".xacro":
+        raise UrdfError(str(path), "is a xacro file: expand it first (xacro arm.xacro > arm.urdf)")
     if path.suffix == ".urdf":
         if not path.is_file():
             raise UrdfError(str(path), "no such file")

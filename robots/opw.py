@@ -101,17 +101,13 @@ def _line_distance(p1: Array, d1: Array, p2: Array, d2: Array) -> tuple[float, A
     return float(np.linalg.norm(c1 - c2)), 0.5 * (c1 + c2)
 
 
-def _refuse(joint: str, prop: str) -> NotOpwError:
-    return NotOpwError(joint, prop)
-
-
 def derive_opw(lines: list[JointLine], T_base_tool0: Array) -> OpwParameters:
     """OPW parameters from six joint axis lines at q = 0 and ``T_base_tool0`` at q = 0.
 
     Raises :class:`NotOpwError` naming the joint and the property that fails.
     """
     if len(lines) != 6:
-        raise _refuse("(chain)", f"has {len(lines)} moving joints, OPW needs 6 revolute joints")
+        raise NotOpwError("(chain)", f"has {len(lines)} moving joints, OPW needs 6 revolute joints")
     n = [ln.name for ln in lines]
     p = [np.array(ln.point, float) for ln in lines]
     w_ = [np.array(ln.direction, float) / np.linalg.norm(ln.direction) for ln in lines]
@@ -119,16 +115,16 @@ def derive_opw(lines: list[JointLine], T_base_tool0: Array) -> OpwParameters:
     z = np.array([0.0, 0.0, 1.0])
     # joint 1: the base z axis through base_link's origin
     if np.linalg.norm(np.cross(w_[0], z)) > tol:
-        raise _refuse(n[0], f"axis {np.round(w_[0], 6).tolist()} is not the base z axis")
+        raise NotOpwError(n[0], f"axis {np.round(w_[0], 6).tolist()} is not the base z axis")
     if math.hypot(p[0][0], p[0][1]) > tol:
         off = math.hypot(p[0][0], p[0][1])
-        raise _refuse(n[0], f"axis does not pass through base_link's origin ({off:.6g} m off)")
+        raise NotOpwError(n[0], f"axis does not pass through base_link's origin ({off:.6g} m off)")
     s1 = _sign(w_[0][2])
     # joint 2: perpendicular to joint 1; its horizontal offset fixes the arm frame's x
     if abs(w_[1][2]) > tol:
-        raise _refuse(n[1], "axis is not perpendicular to joint_1's axis")
+        raise NotOpwError(n[1], f"axis is not perpendicular to {n[0]}'s axis")
     w2 = np.array([w_[1][0], w_[1][1], 0.0]) / math.hypot(w_[1][0], w_[1][1])
-    x_arm = _arm_x(p[1], w2, lines, p)
+    x_arm = _arm_x(w2, p)
     y_arm = np.cross(z, x_arm)
     theta1 = math.atan2(x_arm[1], x_arm[0])
     R_A = np.column_stack((x_arm, y_arm, z))
@@ -138,26 +134,26 @@ def derive_opw(lines: list[JointLine], T_base_tool0: Array) -> OpwParameters:
     a1, c1 = float(pa[1][0]), float(pa[1][2])
     # joint 3 parallel to joint 2
     if np.linalg.norm(np.cross(wa[2], wa[1])) > tol:
-        raise _refuse(n[2], "axis is not parallel to joint_2's axis")
+        raise NotOpwError(n[2], f"axis is not parallel to {n[1]}'s axis")
     s3 = _sign(wa[2][1])
     ux, uz = float(pa[2][0]) - a1, float(pa[2][2]) - c1
     c2 = math.hypot(ux, uz)
     if c2 < tol:
-        raise _refuse(n[2], "axis coincides with joint_2's axis (no upper arm)")
+        raise NotOpwError(n[2], f"axis coincides with {n[1]}'s axis (no upper arm)")
     theta2 = math.atan2(ux, uz)
     # spherical wrist: joints 4, 5, 6 meet in one point
     if abs(wa[3][1]) > tol:
-        raise _refuse(n[3], "axis is not perpendicular to joint_3's axis")
+        raise NotOpwError(n[3], f"axis is not perpendicular to {n[2]}'s axis")
     if abs(float(wa[4] @ wa[3])) > tol:
-        raise _refuse(n[4], "axis is not perpendicular to joint_4's axis")
+        raise NotOpwError(n[4], f"axis is not perpendicular to {n[3]}'s axis")
     gap45, wc = _line_distance(pa[3], wa[3], pa[4], wa[4])
     if gap45 > tol:
-        raise _refuse(n[4], f"axis misses joint_4's axis by {gap45:.6g} m (wrist not spherical)")
+        raise NotOpwError(n[4], f"axis misses {n[3]}'s axis by {gap45:.6g} m (wrist not spherical)")
     if abs(float(wa[5] @ wa[4])) > tol:
-        raise _refuse(n[5], "axis is not perpendicular to joint_5's axis")
+        raise NotOpwError(n[5], f"axis is not perpendicular to {n[4]}'s axis")
     miss6 = float(np.linalg.norm(np.cross(wc - pa[5], wa[5])))
     if miss6 > tol:
-        raise _refuse(n[5], f"axis misses the wrist centre by {miss6:.6g} m (wrist not spherical)")
+        raise NotOpwError(n[5], f"axis misses the wrist centre by {miss6:.6g} m (not spherical)")
     dx, dz = float(wc[0]) - float(pa[2][0]), float(wc[2]) - float(pa[2][2])
     f = np.array([wa[3][0], 0.0, wa[3][2]])
     f /= np.linalg.norm(f)
@@ -201,9 +197,9 @@ def derive_opw(lines: list[JointLine], T_base_tool0: Array) -> OpwParameters:
     )
 
 
-def _arm_x(p2: Array, w2: Array, lines: list[JointLine], p: list[Array]) -> Array:
+def _arm_x(w2: Array, p: list[Array]) -> Array:
     """The arm frame's x: from the J1 axis toward the J2 axis (or the wrist when they meet)."""
-    for point in (p2, p[3], p[4]):
+    for point in (p[1], p[3], p[4]):
         h = np.array([point[0], point[1], 0.0])
         h -= (h @ w2) * w2
         if np.linalg.norm(h) > GEOMETRY_TOL:

@@ -8,7 +8,15 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
-from urdf_factory import ABB_LIKE, KUKA_LIKE, ArmSketch, write_obj, write_stl, write_urdf
+from urdf_factory import (
+    ABB_LIKE,
+    KUKA_LIKE,
+    ArmSketch,
+    write_dae,
+    write_obj,
+    write_stl,
+    write_urdf,
+)
 
 from robots import MODELS, Arm, LimitsError, MeshError, NotOpwError, UrdfError, dh_table, fk_dh
 from robots.opw import fk_opw
@@ -189,6 +197,20 @@ def test_mesh_collision_against_an_obstacle(tmp_path: Path) -> None:
     arm.add_obstacles([Shape("sphere", (0.01,), link6 @ make_transform(t=[0, 0, 0.155]), "in")])
     assert arm.in_collision(q) and arm.collision.in_collision_exhaustive(q)
     assert any("link_6" in a or "link_6" in b for a, b in arm.colliding_pairs(q))
+
+
+@pytest.mark.parametrize("writer", [write_stl, write_obj, write_dae], ids=["stl", "obj", "dae"])
+def test_stl_obj_and_dae_meshes_are_the_same_box(tmp_path: Path, writer) -> None:
+    from robots import Shape
+    from robots.transforms import make_transform
+
+    suffix = {write_stl: "stl", write_obj: "obj", write_dae: "dae"}[writer]
+    writer(tmp_path / "m" / f"l6.{suffix}", (0.06, 0.3, 0.3))
+    arm = _arm(tmp_path, ABB_LIKE.with_(mesh_uris={"link_6": f"m/l6.{suffix}"}))
+    q = np.array([0.0, 0.0, 0.0, 0.0, 0.3, 0.0])
+    link6 = arm.fk(q, "flange") @ make_transform(t=[-0.1, 0.0, 0.0])
+    arm.add_obstacles([Shape("sphere", (0.01,), link6 @ make_transform(t=[0, 0.2, 0]), "p")])
+    assert arm.clearance(q) == pytest.approx(0.2 - 0.15 - 0.01, abs=1e-6)
 
 
 def test_limits_are_narrowed_never_widened(tmp_path: Path) -> None:

@@ -160,3 +160,36 @@ def write_obj(path: Path, size: tuple[float, float, float]) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def write_dae(path: Path, size: tuple[float, float, float]) -> Path:
+    """A minimal COLLADA 1.4 file of a box (m): one triangle mesh, one node."""
+    v, tris = box_triangles(size)
+    positions = " ".join(_fmt(p) for p in v)
+    indices = " ".join(str(i) for i in tris.ravel())
+    text = f"""<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries>
+    <geometry id="box" name="box"><mesh>
+      <source id="box-pos">
+        <float_array id="box-pos-array" count="{v.size}">{positions}</float_array>
+        <technique_common><accessor source="#box-pos-array" count="{len(v)}" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common>
+      </source>
+      <vertices id="box-vtx"><input semantic="POSITION" source="#box-pos"/></vertices>
+      <triangles count="{len(tris)}">
+        <input semantic="VERTEX" source="#box-vtx" offset="0"/><p>{indices}</p>
+      </triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="box-node"><instance_geometry url="#box"/></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+"""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
