@@ -79,6 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--time-budget", type=float, default=None, metavar="S")
     p.add_argument("--roll-step-deg", type=float, default=15.0)
     p.add_argument("--tilt-deg", type=float, default=0.0)
+    p.add_argument("--fallback-tilt-deg", type=float, default=10.0)
     p.add_argument("--dt", type=float, default=0.004)
     p.add_argument("--dwell", type=float, default=0.2)
     p.add_argument("--force", action="store_true", help="plan every cell again")
