@@ -29,12 +29,23 @@ Array = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class DHTable:
-    """A six-link classic D-H table (m, rad)."""
+    """A six-link classic D-H table (m, rad).
+
+    ``joint_sign`` (+1/-1 per joint, default all +1) turns URDF joint values into D-H ones,
+    ``theta_i = joint_sign_i * q_i + theta_offset_i``: -1 where the joint turns about -z_{i-1}
+    (joint 1 of a KUKA arm turns about -z of ``base_link``, which frame 0 must be).
+    """
 
     a_m: tuple[float, ...]
     d_m: tuple[float, ...]
     alpha_rad: tuple[float, ...]
     theta_offset_rad: tuple[float, ...]
+    joint_sign: tuple[float, ...] = (1.0,) * 6
+
+    def joint_values(self, q: ArrayLike) -> Array:
+        """D-H joint variables ``joint_sign * q`` (rad) of URDF joint values ``q`` (..., 6)."""
+        q = np.asarray(q, dtype=float)
+        return q if all(s == 1.0 for s in self.joint_sign) else q * np.asarray(self.joint_sign)
 
     def arrays(self) -> tuple[Array, Array, Array, Array]:
         """``(a, d, alpha, theta_offset)`` as float arrays."""
@@ -103,7 +114,7 @@ def _rotating_rows(T: Array, theta: Array, a: ArrayLike, ca: Array, sa: Array) -
 def link_transforms(table: DHTable, q: ArrayLike) -> Array:
     """Per-link transforms ``T_{i-1,i}``, shape ``(..., 6, 4, 4)``, for joints ``q`` (..., 6)."""
     a, offset, ca, sa, rows = _constant_rows(table)
-    theta = np.asarray(q, dtype=float) + offset
+    theta = table.joint_values(q) + offset
     T = np.empty((*theta.shape, 4, 4))
     _rotating_rows(T, theta, a, ca, sa)
     T[..., 2:, :] = rows
@@ -145,7 +156,10 @@ def fk_dh(table: DHTable, q: ArrayLike) -> Array:
 def fk_dh_arrays(
     a: ArrayLike, d: ArrayLike, alpha: ArrayLike, theta_offset: ArrayLike, q: ArrayLike
 ) -> Array:
-    """``T_base_tool0`` (..., 4, 4) for D-H arrays that may differ per row (see ``fk_dh``)."""
+    """``T_base_tool0`` (..., 4, 4) for D-H arrays that may differ per row (see ``fk_dh``).
+
+    ``q`` are D-H joint variables (``DHTable.joint_values`` of URDF values).
+    """
     return chain(link_transforms_arrays(a, d, alpha, theta_offset, q))
 
 

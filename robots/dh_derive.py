@@ -7,9 +7,9 @@ axis i; for parallel axes from the previous origin); where the axes meet, ``x_i 
 z_i`` with the sign closest to ``x_{i-1}``. For the ABB layout this gives exactly the table of
 the ABB documentation (alpha -pi/2, 0, -pi/2, pi/2, -pi/2, 0; offsets 0, -pi/2, 0, 0, 0, pi).
 
-Two things a D-H table with frame 0 = ``base_link`` cannot say are refused with
-:class:`DHFormError`: a joint 1 turning about -z (KUKA's ``joint_a1``) and a ``tool0`` whose z is
-not along joint 6's axis or whose origin is off it.
+A joint 1 turning about -z (KUKA's ``joint_a1``) gets ``joint_sign`` -1 (frame 0 must be
+``base_link``, z up). A ``tool0`` whose z is not along joint 6's axis or whose origin is off it has
+no D-H form with frame 6 = ``tool0`` and is refused with :class:`DHFormError`.
 """
 
 from __future__ import annotations
@@ -70,12 +70,14 @@ def dh_from_lines(lines: list[JointLine], T_base_tool0_zero: Array) -> DHTable:
     """The D-H table (m, rad) of six joint axis lines at q = 0 and ``tool0`` at q = 0."""
     pts = [np.array(ln.point, float) for ln in lines]
     dirs = [np.array(ln.direction, float) / np.linalg.norm(ln.direction) for ln in lines]
-    if np.linalg.norm(dirs[0] - [0.0, 0.0, 1.0]) > TOL or math.hypot(*pts[0][:2]) > TOL:
+    if np.linalg.norm(np.cross(dirs[0], [0.0, 0.0, 1.0])) > TOL or math.hypot(*pts[0][:2]) > TOL:
         raise DHFormError(
             lines[0].name,
-            "the D-H form (frame 0 = base_link) needs joint 1 to turn about +z through the origin",
+            "the D-H form (frame 0 = base_link) needs joint 1 to turn about z through the origin",
         )
-    o, x, z = np.zeros(3), np.array([1.0, 0.0, 0.0]), dirs[0]
+    # frame 0 is base_link: z0 = +z; a joint 1 about -z gets joint_sign -1
+    sign1 = 1.0 if dirs[0][2] > 0 else -1.0
+    o, x, z = np.zeros(3), np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
     a, d, alpha, theta = [], [], [], []
     for i in range(5):
         foot, x_new, length = _common_normal(o, z, pts[i + 1], dirs[i + 1], x)
@@ -102,4 +104,5 @@ def dh_from_lines(lines: list[JointLine], T_base_tool0_zero: Array) -> DHTable:
         d_m=tuple(_snap_length(v) for v in d),
         alpha_rad=tuple(_snap_angle(v) for v in alpha),
         theta_offset_rad=tuple(_snap_angle(v) for v in theta),
+        joint_sign=(sign1, 1.0, 1.0, 1.0, 1.0, 1.0),
     )

@@ -9,8 +9,8 @@ q6 + pi). That is up to 8 branches, numbered ``4 * back + 2 * elbow + wrist_flip
 joint value 2*pi apart that lies within the limits is returned too. Every solution is checked
 by forward kinematics (position 1e-9 m, orientation 1e-9 rad).
 
-:func:`solve_ik` takes a D-H table of the ABB layout (:mod:`robots.dh`) and solves it through
-the same OPW solver; :func:`solve_opw` takes OPW parameters of any arm of the family.
+:func:`solve_ik` takes a D-H table (:mod:`robots.dh`) and solves it through the same OPW
+solver; :func:`solve_opw` takes OPW parameters of any arm of the family.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from itertools import product
 import numpy as np
 from numpy.typing import NDArray
 
-from robots.dh import DHTable, fk_dh
+from robots.dh import DHTable, fk_dh, fk_dh_frames
 from robots.dh_derive import dh_from_lines
-from robots.opw import OpwParameters, fk_opw, joint_lines_of
+from robots.opw import JointLine, OpwParameters, derive_opw, fk_opw, joint_lines_of
 
 Array = NDArray[np.float64]
 
@@ -37,9 +37,6 @@ SHOULDER_SINGULAR_TOL_M = 1e-9
 #: forward kinematics must reproduce the target to within these
 POSITION_TOL_M = 1e-9
 ORIENTATION_TOL = 1e-9
-#: the ABB D-H layout: alpha and theta offsets (rad)
-ABB_ALPHA = (-math.pi / 2, 0.0, -math.pi / 2, math.pi / 2, -math.pi / 2, 0.0)
-ABB_THETA_OFFSET = (0.0, -math.pi / 2, 0.0, 0.0, 0.0, math.pi)
 
 
 @dataclass(frozen=True)
@@ -115,33 +112,23 @@ def _canonical_table(params: OpwParameters) -> DHTable:
     return dh_from_lines(joint_lines_of(canon), fk_opw(canon, np.zeros(6)))
 
 
-def opw_of_abb_table(table: DHTable) -> OpwParameters:
-    """OPW parameters of a D-H table with the ABB layout (alpha, theta offsets of ABB_*)."""
-    return _opw_of_abb_table(table)
+def opw_of_table(table: DHTable) -> OpwParameters:
+    """OPW parameters of a D-H table (its joint axes at q = 0); NotOpwError if it has none."""
+    return _opw_of_table(table)
 
 
 @lru_cache(maxsize=64)
-def _opw_of_abb_table(table: DHTable) -> OpwParameters:
-    a, d = table.a_m, table.d_m
-    layout = np.allclose(table.alpha_rad, ABB_ALPHA, atol=1e-12) and np.allclose(
-        table.theta_offset_rad, ABB_THETA_OFFSET, atol=1e-12
-    )
-    if not layout or any(abs(v) > 0 for v in (a[3], a[4], a[5], d[1], d[2], d[4])):
-        raise ValueError("solve_ik takes a D-H table of the ABB layout; use solve_opw otherwise")
-    # ABB: forearm along +x at q = 0 (canonical J3 offset pi/2), forearm step a3 above J3
-    return OpwParameters(
-        a1=a[0],
-        a2=-a[2],
-        b=0.0,
-        c1=d[0],
-        c2=a[1],
-        c3=d[3],
-        c4=d[5],
-        sign=(1.0,) * 6,
-        offset_rad=(0.0, 0.0, math.pi / 2, 0.0, 0.0, 0.0),
-        T_E_tool0=tuple(tuple(r) for r in np.eye(4).tolist()),
-        joint_names=("joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6"),
-    )
+def _opw_of_table(table: DHTable) -> OpwParameters:
+    frames = fk_dh_frames(table, np.zeros(6))
+    lines = [
+        JointLine(
+            f"joint_{i + 1}",
+            tuple(frames[i, :3, 3].tolist()),
+            tuple((frames[i, :3, 2] * table.joint_sign[i]).tolist()),
+        )
+        for i in range(6)
+    ]
+    return derive_opw(lines, frames[6])
 
 
 def _arm_solutions(
@@ -235,10 +222,11 @@ def solve_opw(params: OpwParameters, T_base_tool0: Array, lower: Array, upper: A
 def solve_ik(table: DHTable, T_base_tool0: Array, lower: Array, upper: Array) -> IKResult:
     """Every joint solution (rad) placing ``tool0`` at ``T_base_tool0`` within ``[lower, upper]``.
 
-    The table must have the ABB layout (alpha and theta offsets of ``ABB_*``, lengths may
-    differ); solutions are also checked against the table's own forward kinematics.
+    Any table of an OPW chain (the ABB layout, a Fanuc's, a KUKA's with ``joint_sign``): its
+    OPW parameters are read from its joint axes at q = 0; solutions are also checked against the
+    table's own forward kinematics.
     """
-    result = solve_opw(opw_of_abb_table(table), T_base_tool0, lower, upper)
+    result = solve_opw(opw_of_table(table), T_base_tool0, lower, upper)
     if result.ok:
         ok = _verified(fk_dh(table, result.solutions), T_base_tool0)
         return IKResult(result.solutions[ok], result.branches[ok], result.reason, result.n_branches)

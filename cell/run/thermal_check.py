@@ -44,6 +44,9 @@ def check_model_for_cell(model: ThermalModel, arm: Arm, robot_model: str, where:
                                  model.table.arrays(), arm.dh.arrays(), strict=True):  # fmt: skip
         if not np.allclose(mine, cells, rtol=0.0, atol=ATOL):
             raise ThermalModelMismatchError(where, f"dh.{name}", _fmt(mine), _fmt(cells))
+    if model.table.joint_sign != arm.dh.joint_sign:
+        raise ThermalModelMismatchError(where, "dh.joint_sign", _fmt(model.table.joint_sign),
+                                        _fmt(arm.dh.joint_sign))  # fmt: skip
     for name, mine, cells in (("T_cell_base", model.T_cell_base, arm.T_cell_base),
                               ("T_tool0_tcp", model.T_tool0_tcp, arm.T_tool0_tcp)):  # fmt: skip
         if not np.allclose(mine, cells, rtol=0.0, atol=ATOL):

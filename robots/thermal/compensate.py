@@ -121,7 +121,7 @@ def _jacobian(table: DHTable, q: Array, T_tool0_tcp: Array) -> tuple[Array, Arra
     """Geometric Jacobian (6, 6) in the base frame at the TCP, and ``T_base_tcp``."""
     frames = fk_dh_frames(table, q)
     T_base_tcp = frames[6] @ T_tool0_tcp
-    z = frames[:6, :3, 2]
+    z = frames[:6, :3, 2] * np.asarray(table.joint_sign)[:, None]  # each joint's own axis
     o = frames[:6, :3, 3]
     Jv = np.cross(z, T_base_tcp[:3, 3] - o).T
     return np.vstack((Jv, z.T)), T_base_tcp

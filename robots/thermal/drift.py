@@ -161,7 +161,7 @@ class DriftTruth:
             self.settings.offset_drift_rad_per_K,
             self.link_rise_K(t_s),
         )
-        return fk_rows(a, d, alpha, theta, q)
+        return fk_rows(a, d, alpha, theta, self.table.joint_values(q))
 
 
 def default_settings(per_joint_noise_K: float = 0.05) -> DriftSettings:

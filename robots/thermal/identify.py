@@ -147,7 +147,7 @@ class _Problem:
         }
         k, c = coefficient_vectors(values)
         a, d, alpha, theta = drifted_arrays(self.table, k, c, self.dT)
-        T = fk_rows(a, d, alpha, theta, self.q)
+        T = fk_rows(a, d, alpha, theta, self.table.joint_values(self.q))
         return self.demean(predict_p_tcp(T, self.geometry.T_tool0_tcp, self.p_base))
 
     def residual(self, terms: tuple[str, ...], x: Array) -> Array:

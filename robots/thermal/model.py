@@ -215,7 +215,7 @@ class ThermalModel:
     def fk(self, q: ArrayLike, temps_degC: ArrayLike) -> Array:
         """Compensated ``T_base_tool0`` at joints ``q`` (..., 6) and readings (..., n_sensors)."""
         a, d, alpha, theta = self.arrays_at(temps_degC)
-        return fk_rows(a, d, alpha, theta, q)
+        return fk_rows(a, d, alpha, theta, self.table.joint_values(q))
 
     def predict_covariance(
         self,

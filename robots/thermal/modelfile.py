@@ -4,6 +4,7 @@ Layout (SI units; temperatures in degC)::
 
     {"format": "holecell.thermal/1", "robot_model": "abb_irb2600_20_165",
      "dh": {"a_m": [...6], "d_m": [...6], "alpha_rad": [...6], "theta_offset_rad": [...6]},
+            (and "joint_sign": [...6] of +1/-1 when a joint turns about -z_{i-1}, e.g. KUKA's J1)
      "sensors": {"names": ["j1", ...], "reference_degC": [...], "link_sensors": [...6 names]},
      "terms": {"lengths": true, "offsets": false},
      "coefficients": {"k_link2": {"value": 2.3e-05, "std": 4e-07, "unit": "1/K"}, ...},
@@ -22,6 +23,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +54,11 @@ def model_to_dict(model: ThermalModel) -> dict[str, Any]:
             "d_m": d.tolist(),
             "alpha_rad": alpha.tolist(),
             "theta_offset_rad": theta.tolist(),
+            **(
+                {"joint_sign": list(model.table.joint_sign)}
+                if -1.0 in model.table.joint_sign
+                else {}
+            ),
         },
         "sensors": {
             "names": list(spec.sensor_names),
@@ -160,7 +167,13 @@ def model_from_dict(doc: Any, src: str = "thermal.json") -> ThermalModel:
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise ThermalModelFileError(src, "format", f"expected {FORMAT!r}, found {found!r}")
-    table = DHTable(*(tuple(_vector(doc, f"dh.{k}", src, 6)) for k in DHTable.__dataclass_fields__))
+    rows = ("a_m", "d_m", "alpha_rad", "theta_offset_rad")
+    table = DHTable(*(tuple(_vector(doc, f"dh.{k}", src, 6)) for k in rows))
+    if "joint_sign" in _get(doc, "dh", src):  # written only for arms with a -1
+        sign = tuple(_vector(doc, "dh.joint_sign", src, 6))
+        if any(v not in (1.0, -1.0) for v in sign):
+            raise ThermalModelFileError(src, "dh.joint_sign", f"entries must be +1 or -1: {sign}")
+        table = replace(table, joint_sign=sign)
     names = tuple(str(n) for n in _get(doc, "sensors.names", src))
     try:
         spec = ThermalSpec.mapped(

@@ -59,7 +59,7 @@ def term_jacobian(
     p_tcp = np.zeros(3) if point_tcp_m is None else np.asarray(point_tcp_m, float)
     if p_tcp.shape != (3,) or not np.all(np.isfinite(p_tcp)):
         raise ThermalSpecError("point_tcp_m", point_tcp_m, "expected three finite numbers (m)")
-    q = np.asarray(q, float)
+    q = model.table.joint_values(np.asarray(q, float))  # D-H joint variables
     temps = np.asarray(temps_degC, float)
     dT = model.spec.link_delta_K(temps)
     a0, d0, alpha, off0 = model.table.arrays()

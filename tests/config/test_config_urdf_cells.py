@@ -73,7 +73,7 @@ def test_cell_show_and_ik_with_a_urdf_cell(
     assert code in (0, 1), out
     assert "kuka_like" in out and "7 collision meshes" in out
     assert "signs [-1, 1, 1, -1, 1, -1]" in out
-    assert "none: joint_a1" in out  # no D-H form: J1 turns about -z
+    assert "D-H     derived from the same axes" in out
 
 
 def test_shipped_urdf_as_a_path_works_like_the_name(tmp_path: Path) -> None:

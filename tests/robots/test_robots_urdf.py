@@ -43,9 +43,10 @@ def test_kuka_like_parameters_and_signs(tmp_path: Path) -> None:
     assert (p.a2, p.c3) == pytest.approx((0.035, 0.67), abs=1e-12)
     assert p.sign == (-1.0, 1.0, 1.0, -1.0, 1.0, -1.0)
     assert arm.joint_names == KUKA_LIKE.names
-    # J1 about -z has no D-H form with frame 0 = base_link: said when asked, not at load
-    with pytest.raises(UrdfError, match="joint_a1"):
-        _ = arm.dh
+    # J1 about -z: the D-H rows (frame 0 = base_link) turn joint 1 with joint_sign -1
+    assert arm.dh.joint_sign == (-1.0, 1.0, 1.0, 1.0, 1.0, 1.0)
+    Q = np.random.default_rng(4).uniform(arm.lower, arm.upper, (50, 6))
+    assert max(np.abs(fk_dh(arm.dh, q) - arm.fk(q, "tool0")).max() for q in Q) < 1e-9
 
 
 @pytest.mark.parametrize("sketch", [ABB_LIKE, KUKA_LIKE], ids=["abb_like", "kuka_like"])
