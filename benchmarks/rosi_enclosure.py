@@ -2,9 +2,9 @@
 
 Usage: ``python benchmarks/rosi_enclosure.py ABB_EXPERIMENTAL_CHECKOUT [URDF_DIR]``
 
-For each built-in model (the ROS-I joint origins equal ours and their collision origins are
-identity, so each mesh is in our link frame; link frames compared over 200 random
-configurations in docs/abb_kinematics.md: 0 m), the mesh vertices plus 20000 surface samples
+For each built-in model: first the frames (the ROS-I xacro's joint origins and axes against
+ours, and its collision origins, which must be identity for the meshes to be in our link
+frames as they are); then the mesh vertices plus 20000 surface samples
 per link are tested against the union of that link's primitives in ``URDF_DIR`` (default: the
 shipped ``robots/urdf``). Prints the protrusion
 (mm), the primitives' summed volume and the mesh hull's volume (L). Skips without a checkout.
@@ -21,6 +21,7 @@ import pinocchio as pin
 from rosi_meshes import (
     ROSI_MODELS,
     checkout_or_exit,
+    frame_differences,
     load_link_meshes,
     primitive_volume,
     protrusion,
@@ -34,6 +35,12 @@ def main() -> None:
     root = checkout_or_exit(sys.argv, "rosi_enclosure.py ABB_EXPERIMENTAL_CHECKOUT [URDF_DIR]")
     urdf_dir = Path(sys.argv[2]) if len(sys.argv) > 2 else SHIPPED
     print(f"primitives from {urdf_dir}")
+    for model in ROSI_MODELS:
+        joint_diff, collision_offset = frame_differences(root, model)
+        print(
+            f"{model}: ROS-I joint origins and axes vs ours: largest difference {joint_diff:g}; "
+            f"largest collision origin offset {collision_offset:g} (0: meshes in our link frames)"
+        )
     print(f"{'model':20s} {'link':10s} {'protrusion mm':>14s} {'prims L':>8s} {'hull L':>7s}")
     for model in ROSI_MODELS:
         m, geom, _ = pin.buildModelsFromUrdf(str(urdf_dir / f"{model}.urdf"))

@@ -50,6 +50,41 @@ ROSI_MODELS: dict[str, tuple[str, dict[str, str]]] = {
 }
 
 
+def frame_differences(root: Path, model: str) -> tuple[float, float]:
+    """Largest difference between ROS-I's and our joint origins (m, rad) and largest offset
+    of a ROS-I collision origin (m, rad), read from the xacro macro (plain numbers there)."""
+    import xml.etree.ElementTree as ET
+
+    from robots.models import JOINT_AXES, MODELS
+
+    name, table = ROSI_MODELS[model]
+    package = next(iter(table.values())).split("/")[0]
+    tree = ET.parse(root / package / "urdf" / f"{name}_macro.xacro")
+    joints = {j.get("name", "").replace("${prefix}", ""): j for j in tree.iter("joint")}
+    spec = MODELS[model]
+    axis_vec = {"x": (1, 0, 0), "y": (0, 1, 0), "z": (0, 0, 1)}
+    joint_diff = 0.0
+    for i in range(6):
+        j = joints[f"joint_{i + 1}"]
+        origin = j.find("origin")
+        xyz = np.array([float(v) for v in origin.get("xyz", "0 0 0").split()])
+        rpy = np.array([float(v) for v in origin.get("rpy", "0 0 0").split()])
+        axis = np.array([float(v) for v in j.find("axis").get("xyz").split()])
+        joint_diff = max(
+            joint_diff,
+            float(np.abs(xyz - spec.joint_origins_m[i]).max()),
+            float(np.abs(rpy).max()),
+            float(np.abs(axis - axis_vec[JOINT_AXES[i]]).max()),
+        )
+    collision_offset = 0.0
+    for c in tree.iter("collision"):
+        origin = c.find("origin")
+        if origin is not None:
+            values = [float(v) for k in ("xyz", "rpy") for v in origin.get(k, "0 0 0").split()]
+            collision_offset = max(collision_offset, float(np.abs(values).max()))
+    return joint_diff, collision_offset
+
+
 def checkout_or_exit(argv: list[str], usage: str) -> Path:
     """The ROS-I checkout given as the first argument; exits 0 with a message when absent."""
     if len(argv) < 2 or not Path(argv[1]).is_dir():

@@ -66,33 +66,45 @@ def main() -> None:
     for i in bad[:10]:
         print(f"  t = {i * tour.dt:.3f} s: {real.colliding_pairs(tour.trajectory[i])[:3]}")
     names = [g.name for g in real.geom_model.geometryObjects]
-    print(f"\n{'stop':6s} {'tool-arm mm':>12s} {'arm-obst mm':>12s} {'tool-obst mm':>13s}")
+    keys = []
+    for pair in real.geom_model.collisionPairs:
+        a, b = names[pair.first], names[pair.second]
+        tool = a.startswith("tool") or b.startswith("tool")
+        obst = a.startswith("obstacle") or b.startswith("obstacle")
+        keys.append(
+            "tool-obst"
+            if tool and obst
+            else "tool-arm"
+            if tool
+            else "arm-obst"
+            if obst
+            else "arm-arm"
+        )
+
+    def smallest(q: np.ndarray) -> dict[str, float]:
+        pin.computeDistances(real.model, real.data, real.geom_model, real.geom_data, q)
+        best = dict.fromkeys(("tool-arm", "arm-obst", "tool-obst", "arm-arm"), np.inf)
+        for key, res in zip(keys, real.geom_data.distanceResults, strict=True):
+            best[key] = min(best[key], res.min_distance)
+        return best
+
+    cols = ("tool-arm", "arm-obst", "tool-obst", "arm-arm")
+    print(
+        f"\nsmallest distance (mm) to the real meshes\n{'stop':8s} "
+        + " ".join(f"{c:>10s}" for c in cols)
+    )
     for stop in tour.stops:
-        pin.computeDistances(
-            real.model, real.data, real.geom_model, real.geom_data, np.array(stop.q)
-        )
-        best = {"tool-arm": np.inf, "arm-obst": np.inf, "tool-obst": np.inf}
-        for pair, res in zip(
-            real.geom_model.collisionPairs, real.geom_data.distanceResults, strict=True
-        ):
-            a, b = names[pair.first], names[pair.second]
-            tool = a.startswith("tool") or b.startswith("tool")
-            obst = a.startswith("obstacle") or b.startswith("obstacle")
-            key = (
-                "tool-obst"
-                if tool and obst
-                else "tool-arm"
-                if tool
-                else "arm-obst"
-                if obst
-                else None
-            )
-            if key:
-                best[key] = min(best[key], res.min_distance)
-        print(
-            f"{stop.hole_id:6s} {best['tool-arm'] * 1e3:12.1f} {best['arm-obst'] * 1e3:12.1f} "
-            f"{best['tool-obst'] * 1e3:13.1f}"
-        )
+        best = smallest(np.array(stop.q))
+        print(f"{stop.hole_id:8s} " + " ".join(f"{best[c] * 1e3:10.1f}" for c in cols))
+    overall = dict.fromkeys(cols, np.inf)
+    for q in tour.trajectory:
+        for c, d in smallest(q).items():
+            overall[c] = min(overall[c], d)
+    print(
+        f"{'all t':8s} "
+        + " ".join(f"{overall[c] * 1e3:10.1f}" for c in cols)
+        + "   (every trajectory sample)"
+    )
 
 
 if __name__ == "__main__":

@@ -62,6 +62,8 @@ def load_mesh(path: str | Path, scale: float = 1.0) -> TriangleMesh:
         raise MeshFileError(str(p), f"scale must be a positive number, got {scale!r}")
     try:
         mesh = trimesh.load(p, force="mesh", process=False)
+    except ImportError as exc:  # trimesh falls back to text decoding helpers on garbage
+        raise MeshFileError(str(p), f"not a valid {p.suffix.lower()} mesh file") from exc
     except Exception as exc:  # trimesh raises many kinds on a corrupt file
         raise MeshFileError(str(p), f"cannot be read as a mesh: {exc}") from exc
     faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)

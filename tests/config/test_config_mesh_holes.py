@@ -65,6 +65,12 @@ def test_missing_and_empty_meshes_are_refused_naming_field_and_path(tmp_path: Pa
         load_cell(_write_cell(tmp_path, environment__obstacles=ob))
     assert "environment.obstacles[0].mesh.path" in str(err.value)
     assert "empty.stl" in str(err.value)
+    (tmp_path / "noise.stl").write_bytes(np.random.default_rng(0).bytes(3000))
+    ob = [{"mesh": {"path": "noise.stl"}}]
+    with pytest.raises(ConfigError) as err:
+        load_cell(_write_cell(tmp_path, environment__obstacles=ob))
+    assert "environment.obstacles[0].mesh.path" in str(err.value)
+    assert "noise.stl" in str(err.value)
 
 
 HEADER = "id,x_mm,y_mm,z_mm,nx,ny,nz,diameter_mm,tolerance_um\n"
