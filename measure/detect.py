@@ -147,6 +147,35 @@ def check_image(img: np.ndarray, which: str) -> tuple[float, np.ndarray]:
     return full, small
 
 
+def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray | None:
+    """The outline (N, 2) without its concave bites deeper than ``min_depth_px``.
+
+    Something bright inside the bore that touches the rim in the image (a screw head at a
+    tilt) bites into the dark region; the rest of the outline still follows the rim.
+    Returns ``None`` when the bites take half the outline or more.
+    """
+    c = contour.reshape(-1, 1, 2).astype(np.int32)
+    if len(c) < 8:
+        return None
+    try:
+        hull = cv2.convexHull(c, returnPoints=False)
+        defects = cv2.convexityDefects(c, hull)
+    except cv2.error:
+        return None
+    keep = np.ones(len(c), dtype=bool)
+    if defects is not None:
+        for start, end, _, depth in defects.reshape(-1, 4):
+            if depth / 256.0 > min_depth_px:
+                if start <= end:
+                    keep[start + 1 : end] = False
+                else:
+                    keep[start + 1 :] = False
+                    keep[:end] = False
+    if keep.sum() < 0.5 * len(c):
+        return None
+    return c[keep, 0].astype(np.float64)
+
+
 def _disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
     """Does the outline (N, 2) (away from the image border) follow an ellipse?"""
     if border:
@@ -213,6 +242,11 @@ def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, rea
             continue
         if _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
             out.append((m["m10"] / area, m["m01"] / area, area, (x, y, w, h), border, level))
+            continue
+        rest = None if border else without_bites(c)
+        if rest is not None and _disc_like(rest, (H, W), False):  # the rim around a bite
+            (ex, ey), (a2, b2), _ = cv2.fitEllipse(rest.astype(np.float32))
+            out.append((ex, ey, 0.25 * np.pi * a2 * b2, (x, y, w, h), False, level))
     return out
 
 
