@@ -378,6 +378,9 @@ def find_candidates(
         if any(holes for _, holes in found.values()):
             break
     _cross_polarity(found)
+    bores = _bores_in_bright_rings(small, found, min_area, (ox, oy))
+    if bores:
+        return bores
     # dark discs that hold over levels, else bright ones, else any dark, else any bright
     order = [(p, t, [h for h in hs if h[8] >= 2]) for p, (t, hs) in found.items()]
     order += [(p, t, hs) for p, (t, hs) in found.items()]
@@ -385,6 +388,48 @@ def find_candidates(
         if holes:
             return [_candidate(h, polarity, thresholds, (ox, oy)) for h in holes]
     return []
+
+
+def _bores_in_bright_rings(small, found, min_area: float, origin) -> list[HoleCandidate]:
+    """Dark bores centred in bright discs (a flange or washer on a dark background).
+
+    When the image is mostly dark (black cloth, a dark part), the bore is not darker than
+    the median and the dark class finds nothing; a bright disc is then searched inside,
+    with a ladder between the darkest and the median level *within* the disc, for a dark
+    disc at its centre (within 15 % of its radius, 20 … 95 % of its size; the ladder runs
+    up to the disc's 80 % quantile, the ring, since the bore may fill half the disc): that is the
+    hole, the bright disc its flange. Returns those bores (full-resolution candidates).
+    """
+    if "bright" not in found or found.get("dark", (None, []))[1]:
+        return []
+    out = []
+    for b in found["bright"][1]:
+        cx, cy, area, (x, y, w, h), border = b[:5]
+        rb = np.sqrt(area / np.pi)
+        if border or rb < 4:
+            continue
+        crop = np.ascontiguousarray(small[y : y + h, x : x + w])
+        yy, xx = np.mgrid[0:h, 0:w]
+        disc = ((xx + x - cx) ** 2 + (yy + y - cy) ** 2 < rb * rb).astype(np.uint8)
+        hist = cv2.calcHist([crop], [0], disc, [256], [0, 256]).ravel()
+        cdf = np.cumsum(hist) / max(hist.sum(), 1.0)
+        p_lo, p_med = (float(np.searchsorted(cdf, q)) for q in (0.001, 0.8))  # ring: bright
+        if p_med - p_lo < 0.2 * 255:
+            continue
+        thresholds = [p_lo + f * (p_med - p_lo) for f in LADDER]
+        discs = []
+        for k, thr in enumerate(thresholds):
+            mask = (crop <= thr) & (disc > 0)
+            reach = _reach(crop, "dark", thr, p_lo)
+            discs += _discs(mask, min_area, k, False, reach)
+        for d in _group(discs):
+            dx, dy = d[0] + x, d[1] + y
+            rd = np.sqrt(d[2] / np.pi)
+            if np.hypot(dx - cx, dy - cy) < 0.15 * rb and 0.2 * rb < rd < 0.95 * rb:
+                bx, by, bw, bh = d[3]
+                moved = (dx, dy, d[2], (bx + x, by + y, bw, bh), False, d[5], d[6])
+                out.append(_candidate(moved, "dark", thresholds, origin))
+    return out
 
 
 def _candidate(hole: tuple, polarity: str, thresholds: list[float], origin) -> HoleCandidate:
