@@ -23,8 +23,18 @@ normal error (degrees), failures. Targets (default method): |bias| ≤ 2 µm, st
 centre RMS ≤ 10 µm, mean normal error ≤ 0.1°; no more than twice those in the robustness
 cases.
 
-Run: ``.venv/bin/python benchmarks/measure_accuracy.py`` (50 scenes per case, about 8 min
-on one core) or ``--quick`` (8 scenes per case, about 1.5 min).
+Realism (default method only; measure.synth's realism options): the *ladder* adds one
+effect at a time to the ⌀10 mm case (lit bore wall visible at tilt, through-hole against
+a dark and a lit background, a screw head inside, cast texture, a 0.05 mm rounded lip,
+directional light, JPEG q90, Bayer demosaicing, a 12-bit sensor); the *realistic* group
+has all of them at once but the lit background (8-bit Bayer colour, JPEG q92, a 0.03 mm
+rounded lip) for every size and tilt, with targets: no refusal, |bias| ≤ 5 µm, std ≤ 5 µm,
+centre RMS ≤ 15 µm, mean normal error ≤ 0.2°. The *lips* group documents the radius bias
+of quarter-round lips of 0.05, 0.1 and 0.2 mm (truth: the bore edge).
+
+Run: ``.venv/bin/python benchmarks/measure_accuracy.py`` (all groups, 50 scenes per case,
+about 15 min on one idle core) or ``--quick`` (8 scenes per case); ``--group NAME``
+(repeatable: standard, robustness, ladder, realistic, lips) runs only those.
 """
 
 from __future__ import annotations

@@ -147,6 +147,35 @@ def check_image(img: np.ndarray, which: str) -> tuple[float, np.ndarray]:
     return full, small
 
 
+def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray | None:
+    """The outline (N, 2) without its concave bites deeper than ``min_depth_px``.
+
+    Something bright inside the bore that touches the rim in the image (a screw head at a
+    tilt) bites into the dark region; the rest of the outline still follows the rim.
+    Returns ``None`` when the bites take half the outline or more.
+    """
+    c = contour.reshape(-1, 1, 2).astype(np.int32)
+    if len(c) < 8:
+        return None
+    try:
+        hull = cv2.convexHull(c, returnPoints=False)
+        defects = cv2.convexityDefects(c, hull)
+    except cv2.error:
+        return None
+    keep = np.ones(len(c), dtype=bool)
+    if defects is not None:
+        for start, end, _, depth in defects.reshape(-1, 4):
+            if depth / 256.0 > min_depth_px:
+                if start <= end:
+                    keep[start + 1 : end] = False
+                else:
+                    keep[start + 1 :] = False
+                    keep[:end] = False
+    if keep.sum() < 0.5 * len(c):
+        return None
+    return c[keep, 0].astype(np.float64)
+
+
 def _disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
     """Does the outline (N, 2) (away from the image border) follow an ellipse?"""
     if border:
@@ -213,6 +242,11 @@ def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, rea
             continue
         if _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
             out.append((m["m10"] / area, m["m01"] / area, area, (x, y, w, h), border, level))
+            continue
+        rest = None if border else without_bites(c)
+        if rest is not None and _disc_like(rest, (H, W), False):  # the rim around a bite
+            (ex, ey), (a2, b2), _ = cv2.fitEllipse(rest.astype(np.float32))
+            out.append((ex, ey, 0.25 * np.pi * a2 * b2, (x, y, w, h), False, level))
     return out
 
 
@@ -344,6 +378,9 @@ def find_candidates(
         if any(holes for _, holes in found.values()):
             break
     _cross_polarity(found)
+    bores = _bores_in_bright_rings(small, found, min_area, (ox, oy))
+    if bores:
+        return bores
     # dark discs that hold over levels, else bright ones, else any dark, else any bright
     order = [(p, t, [h for h in hs if h[8] >= 2]) for p, (t, hs) in found.items()]
     order += [(p, t, hs) for p, (t, hs) in found.items()]
@@ -351,6 +388,48 @@ def find_candidates(
         if holes:
             return [_candidate(h, polarity, thresholds, (ox, oy)) for h in holes]
     return []
+
+
+def _bores_in_bright_rings(small, found, min_area: float, origin) -> list[HoleCandidate]:
+    """Dark bores centred in bright discs (a flange or washer on a dark background).
+
+    When the image is mostly dark (black cloth, a dark part), the bore is not darker than
+    the median and the dark class finds nothing; a bright disc is then searched inside,
+    with a ladder between the darkest and the median level *within* the disc, for a dark
+    disc at its centre (within 15 % of its radius, 20 … 95 % of its size; the ladder runs
+    up to the disc's 80 % quantile, the ring, since the bore may fill half the disc): that is the
+    hole, the bright disc its flange. Returns those bores (full-resolution candidates).
+    """
+    if "bright" not in found or found.get("dark", (None, []))[1]:
+        return []
+    out = []
+    for b in found["bright"][1]:
+        cx, cy, area, (x, y, w, h), border = b[:5]
+        rb = np.sqrt(area / np.pi)
+        if border or rb < 4:
+            continue
+        crop = np.ascontiguousarray(small[y : y + h, x : x + w])
+        yy, xx = np.mgrid[0:h, 0:w]
+        disc = ((xx + x - cx) ** 2 + (yy + y - cy) ** 2 < rb * rb).astype(np.uint8)
+        hist = cv2.calcHist([crop], [0], disc, [256], [0, 256]).ravel()
+        cdf = np.cumsum(hist) / max(hist.sum(), 1.0)
+        p_lo, p_med = (float(np.searchsorted(cdf, q)) for q in (0.001, 0.8))  # ring: bright
+        if p_med - p_lo < 0.2 * 255:
+            continue
+        thresholds = [p_lo + f * (p_med - p_lo) for f in LADDER]
+        discs = []
+        for k, thr in enumerate(thresholds):
+            mask = (crop <= thr) & (disc > 0)
+            reach = _reach(crop, "dark", thr, p_lo)
+            discs += _discs(mask, min_area, k, False, reach)
+        for d in _group(discs):
+            dx, dy = d[0] + x, d[1] + y
+            rd = np.sqrt(d[2] / np.pi)
+            if np.hypot(dx - cx, dy - cy) < 0.15 * rb and 0.2 * rb < rd < 0.95 * rb:
+                bx, by, bw, bh = d[3]
+                moved = (dx, dy, d[2], (bx + x, by + y, bw, bh), False, d[5], d[6])
+                out.append(_candidate(moved, "dark", thresholds, origin))
+    return out
 
 
 def _candidate(hole: tuple, polarity: str, thresholds: list[float], origin) -> HoleCandidate:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from measure.detect import HoleCandidate
+from measure.detect import HoleCandidate, without_bites
 
 EDGE_METHODS = ("parabola", "linear")
 
@@ -72,13 +72,27 @@ def _median(img: np.ndarray, mask: np.ndarray, full: float) -> float | None:
 
 
 def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
-    """The filled outer outline of the mask component around ``seed`` (ROI pixels)."""
-    contours, _ = cv2.findContours(mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    """The filled outer outline of the mask component around ``seed`` (ROI pixels).
+
+    Islands inside the hole (a screw) do not matter; a bite into the outline (a screw
+    head touching the rim in the image) is bridged by the ellipse through the rest.
+    """
+    contours, _ = cv2.findContours(mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     inside = [c for c in contours if cv2.pointPolygonTest(c, seed, False) >= 0]
     pool = inside or list(contours)
     region = np.zeros(mask.shape, np.uint8)
-    if pool:  # the outer outline, filled: islands inside the hole (a screw) do not matter
-        cv2.drawContours(region, [max(pool, key=cv2.contourArea)], -1, 1, thickness=cv2.FILLED)
+    if not pool:
+        return region
+    c = max(pool, key=cv2.contourArea)
+    cv2.drawContours(region, [c], -1, 1, thickness=cv2.FILLED)
+    area = cv2.contourArea(c)
+    hull_area = cv2.contourArea(cv2.convexHull(c))
+    if len(c) >= 24 and area < 0.97 * hull_area:
+        rest = without_bites(c)
+        if rest is not None and len(rest) >= 12:
+            ell = cv2.fitEllipse(rest.astype(np.float32))
+            if np.all(np.isfinite(ell[1])) and min(ell[1]) > 2:
+                cv2.ellipse(region, ell, 1, thickness=cv2.FILLED)
     return region
 
 

@@ -112,10 +112,23 @@ def _rim(cl, cr, reg_l, reg_r, small_l, small_r, depth_m) -> RimChoice:
 
 
 def _suspect_reasons(
-    opts: MeasureOptions, bad: int, n_contour: int, rms_m: float, px_m: float, rim: RimChoice
+    opts: MeasureOptions,
+    bad: int,
+    n_contour: int,
+    rms_m: float,
+    px_m: float,
+    rim: RimChoice,
+    rows: tuple[float, float],
 ) -> tuple[str, ...]:
     """Why a measurement is suspect (thresholds: :class:`MeasureOptions`)."""
     out = []
+    if max(rows) > opts.suspect_epipolar_px:
+        out.append(
+            f"the rims' top and bottom rows differ by {rows[0]:.1f} / {rows[1]:.1f} px after "
+            f"rectification (at most {opts.suspect_epipolar_px:g} px): the cameras see "
+            "different rims (a chamfer or lip seen from two sides) or the calibration does "
+            "not fit the images"
+        )
     if bad > opts.suspect_fraction * n_contour:
         out.append(
             f"{bad} of {n_contour} contour samples filled or rejected "
@@ -237,7 +250,11 @@ def measure_hole(
     n_contour = len(con_l.points_px) + len(con_r.points_px)
     bad = n_filled + con_l.n_outliers + con_r.n_outliers + circ.n_rejected
     px_m = float(circ.center[2]) / float(stereo.K_left[0, 0])  # one pixel at the hole, m
-    reasons = _suspect_reasons(opts, bad, n_contour, circ.rms_m, px_m, rim)
+    rows = (
+        abs(float(rl[:, 1].min() - rr[:, 1].min())),
+        abs(float(rl[:, 1].max() - rr[:, 1].max())),
+    )
+    reasons = _suspect_reasons(opts, bad, n_contour, circ.rms_m, px_m, rim, rows)
     status = "suspect" if reasons else "ok"
     total = time.perf_counter() - t0
     return HoleMeasurement(

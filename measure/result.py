@@ -41,6 +41,9 @@ class MeasureOptions:
         suspect_rim_mismatch: status ``"suspect"`` when the left and right edges used were
             found at gray levels (inside, outside) that differ by more than this fraction
             of the contrast: the two images may show different edges.
+        suspect_epipolar_px: status ``"suspect"`` when the top or bottom rows of the two
+            rectified contours differ by more than this (pixels): both are tangent to the
+            same epipolar planes when the calibration fits the images.
     """
 
     edge_method: str = "parabola"
@@ -58,6 +61,7 @@ class MeasureOptions:
     suspect_rms_m: float = 25e-6
     suspect_rms_px: float = 0.3
     suspect_rim_mismatch: float = 0.5
+    suspect_epipolar_px: float = 1.5
 
     @classmethod
     def published(cls) -> MeasureOptions:

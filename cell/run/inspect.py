@@ -64,7 +64,13 @@ def inspect_hole(
     base = _base_fields(hole, stop_index, nominal, q_rad, temps_c, sim_time_s)
     t0 = time.perf_counter()
     try:
-        meas = measure_hole(left, right, stereo, expected_diameter_m=hole.diameter_m)
+        meas = measure_hole(
+            left,
+            right,
+            stereo,
+            expected_diameter_m=hole.diameter_m,
+            expected_standoff_m=cell.tool.standoff_m,
+        )
     except HoleNotFoundError as exc:
         return HoleResult(status="missing", reason=f"no hole found: {exc}", **base), None
     except MeasurementError as exc:
