@@ -22,7 +22,7 @@ Then the reference plan designed for the tour against the old plan on an indepen
 truth (``benchmarks/thermal_design.py``, ``benchmarks/thermal_truth.py``), with the predicted
 against the actual residual, including a truth whose links lag their sensors.
 
-Run: ``.venv/bin/python benchmarks/thermal_compensation.py`` (about 30 s).
+Run: ``.venv/bin/python benchmarks/thermal_compensation.py`` (about 60 s).
 """
 
 from __future__ import annotations

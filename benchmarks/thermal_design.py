@@ -13,7 +13,7 @@ tour's stops is compared with
 - *predicted (design)*: the design's a-priori figure (anticipated warm-up, nominal noise).
 
 Random workspace poses at random moments give the error away from the tour.
-Run: ``.venv/bin/python benchmarks/thermal_design.py`` (about 30 s); also part of
+Run: ``.venv/bin/python benchmarks/thermal_design.py`` (about 40 s); also part of
 ``benchmarks/thermal_compensation.py``.
 """
 
@@ -35,7 +35,7 @@ from thermal_truth import IndependentTruth, NetworkSettings
 
 TIMES_S = np.arange(0.0, 7200.0 + 1.0, 300.0)
 NOISE_M = 5e-6
-N_SEEDS = 10
+N_SEEDS = 20
 N_RANDOM = 200
 LAG_S = 1200.0
 #: a third target on the table's front edge, where the design says it helps most (docs/thermal.md)

@@ -30,6 +30,7 @@ from cell.run.setup import check_tour
 from cell.run.target_suggest import suggest_targets
 from planner import load_tour
 from robots.thermal.design import Design, DesignOptions, evaluate
+from robots.thermal.errors import ThermalError
 from robots.thermal.plan import view_plan
 
 VIEW_COLUMNS = ("view_id", "target_id", *(f"q{i}_rad" for i in range(1, 7)), "tilt_rad",
@@ -171,11 +172,11 @@ def run_plan_views(args: argparse.Namespace) -> int:
     if not args.output.parent.is_dir():
         raise CellError(f"-o {args.output}: the directory {args.output.parent} does not exist")
     extra = [_target(t, k) for k, t in enumerate(args.try_target)]
-    names, stops = _stops(cell, args.tour)
     if args.every_s > args.hours * 3600:
         raise CellError(
             f"--every-s {args.every_s:g}: longer than the warm-up (--hours {args.hours:g})"
         )
+    names, stops = _stops(cell, args.tour)
     options = DesignOptions(
         n_views=args.views or None, duration_s=args.hours * 3600, every_s=args.every_s,
         noise_m=args.noise_um * 1e-6,
@@ -198,8 +199,11 @@ def run_plan_views(args: argparse.Namespace) -> int:
     for name, s in zip(names, design.stop_sigma_m, strict=True):
         print(f"  {name:<10} {s * 1e6:7.2f} um")
     print(f"RMS over the stops {rms * 1e6:.2f} um, max {design.stop_sigma_m.max() * 1e6:.2f} um")
-    old = _old_plan_rms(cell, stops, options)
-    print(f"old recommended plan (3 fixed views per target): RMS {old * 1e6:.2f} um")
+    try:
+        old = f"RMS {_old_plan_rms(cell, stops, options) * 1e6:.2f} um"
+    except ThermalError as exc:
+        old = f"not possible ({exc})"
+    print(f"old recommended plan (3 fixed views per target): {old}")
     n_more = len(design.views) + 3
     for t in extra:
         with_t = cell.model_copy(update={"reference_targets": [*cell.reference_targets, t]})

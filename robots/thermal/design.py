@@ -21,8 +21,9 @@ Candidates are every reachable, collision-free arm configuration (one per IK arm
 roll nearest the rest pose: a roll about the view axis does not change a length term's
 information) of every view direction (tilts and azimuths from the target normal) of every
 target; the views are chosen greedily, then improved by exchange (Fedorov) until no single swap
-lowers ``phi``. A small ridge (``prior_per_K``) makes the early, still singular, greedy steps
-comparable; the reported figures are without it.
+lowers ``phi``. A small ridge (``ridge``, relative) makes the early, still singular, greedy
+steps comparable; the reported figures are without it. Noise, schedule and rise only scale
+``phi``, so the choice does not depend on them.
 """
 
 from __future__ import annotations
@@ -58,7 +59,9 @@ class DesignOptions:
         tau_s: its time constant (s).
         duration_s: length of the reference warm-up (s); the stops are predicted at its end.
         every_s: period of the reference rounds (s).
-        prior_per_K: ridge used only while choosing (1/K, prior standard deviation).
+        ridge: ridge used only while choosing, relative to the mean candidate's information
+            (makes the first, still singular, greedy steps comparable; independent of the
+            noise and schedule, so the choice is too).
     """
 
     n_views: int | None = None
@@ -70,7 +73,7 @@ class DesignOptions:
     tau_s: float = 2400.0
     duration_s: float = 7200.0
     every_s: float = 300.0
-    prior_per_K: float = 1e-4  # noqa: N815 (unit suffix)
+    ridge: float = 1e-5
 
     def __post_init__(self) -> None:
         checks = {
@@ -83,7 +86,7 @@ class DesignOptions:
             "tau_s": self.tau_s > 0,
             "duration_s": self.duration_s > 0,
             "every_s": 0 < self.every_s <= self.duration_s,
-            "prior_per_K": self.prior_per_K > 0,
+            "ridge": 0 < self.ridge < 1,
         }
         for name, ok in checks.items():
             if not ok:
@@ -304,9 +307,8 @@ def design_views(
     _, D_s = tcp_sensitivity(table, T_tool0_tcp, stops)
     blocks = np.einsum("vki,vkj->vij", D_v, D_v)
     W = np.einsum("ski,skj->ij", D_s, D_s)
-    # ridge of the prior in the same units as the blocks (m^2 per unit scale^2)
-    s_T, _ = o.temperature_weights()
-    ridge = np.eye(blocks.shape[1]) * o.noise_m**2 / (s_T * o.prior_per_K**2)
+    n_terms = blocks.shape[1]
+    ridge = np.eye(n_terms) * o.ridge * np.trace(blocks.mean(axis=0)) / n_terms
     chosen = _choose(blocks, W, n, ridge, fixed)
     views = [candidates[i] for i in chosen]
     sigma, cov = evaluate(table, T_cell_base, T_tool0_tcp, Q[chosen], stops, o)
