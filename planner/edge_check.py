@@ -30,11 +30,13 @@ def _pool(arm: object, threads: int) -> object | None:
     pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(
         collision.model, collision.geom_model, threads
     )
+    # the same requests as the arm's own checks, clearance margins included
+    margins = [req.security_margin for req in collision.geom_data.collisionRequests]
     for gd in pool.getGeometryDatas():
-        for req in gd.collisionRequests:
+        for req, margin in zip(gd.collisionRequests, margins, strict=True):
             req.enable_contact = True
             req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
-            req.security_margin = 0.0
+            req.security_margin = margin
     return pool
 
 
