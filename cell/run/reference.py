@@ -142,4 +142,8 @@ def plan_reference_tour(
         design = design_reference_plan(cell, stops)
     for tid, reason in design.skipped.items():
         log.info("reference target %s has no view: %s", tid, reason)
+    log.info(
+        "reference plan: %d views designed for %d stops, predicted %.2f um RMS at them",
+        len(design.views), len(design.stop_sigma_m), design.predicted_rms_m * 1e6,
+    )  # fmt: skip
     return _DesignedViewsPlanner(options or Options(), design).plan(reference_cell(cell, design))
