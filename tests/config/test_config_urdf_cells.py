@@ -124,3 +124,20 @@ def test_missing_mesh_in_a_cell_names_the_link_and_path(tmp_path: Path) -> None:
 def test_missing_urdf_file_is_named(tmp_path: Path) -> None:
     field, _, msg = _problem(_write_cell(tmp_path, "robot/nothing.urdf"))
     assert field == "robot.model" and "no such file" in msg
+
+
+def test_plan_a_urdf_cell_and_check_every_sample(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from planner.tour import load_tour
+
+    _kuka_with_meshes(tmp_path)
+    cell = _write_cell(tmp_path, "robot/kuka_like.urdf", "[pkgs]")
+    code = main(["plan", str(cell), "-o", str(tmp_path / "tour.json"), "--quiet"])
+    assert code == 0, capsys.readouterr().out
+    tour = load_tour(tmp_path / "tour.json")
+    assert tuple(tour.joint_names) == KUKA_LIKE.names
+    arm = load_cell(cell).build_arm()
+    traj = np.asarray(tour.trajectory, float)
+    assert len(traj) > 10 and not any(arm.in_collision(q) for q in traj)
+    assert np.all(traj >= arm.lower - 1e-9) and np.all(traj <= arm.upper + 1e-9)
