@@ -302,6 +302,18 @@ def _module_text(figures: dict[str, list[tuple[str, dict]]]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _points_json(points: dict[str, dict[str, list[list[float]]]]) -> str:
+    """The test figures as JSON, one point per line."""
+    models = []
+    for model, links in points.items():
+        rows = []
+        for link, pts in links.items():
+            body = ",\n".join(f"      {json.dumps(p)}" for p in pts)
+            rows.append(f'    "{link}": [\n{body}\n    ]')
+        models.append(f'  "{model}": {{\n' + ",\n".join(rows) + "\n  }")
+    return "{\n" + ",\n".join(models) + "\n}\n"
+
+
 def main() -> None:
     root = checkout_or_exit(sys.argv, "fit_link_shapes.py ABB_EXPERIMENTAL_CHECKOUT [--write]")
     figures: dict[str, list[tuple[str, dict]]] = {}
@@ -338,7 +350,7 @@ def main() -> None:
         (REPO / "robots" / "arm_shapes.py").write_text(_module_text(figures))
         data = REPO / "tests" / "robots" / "data"
         data.mkdir(parents=True, exist_ok=True)
-        (data / "rosi_link_points.json").write_text(json.dumps(points, indent=1) + "\n")
+        (data / "rosi_link_points.json").write_text(_points_json(points))
         print("written robots/arm_shapes.py, tests/robots/data/rosi_link_points.json")
 
 

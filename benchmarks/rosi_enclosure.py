@@ -6,8 +6,8 @@ For each built-in model: first the frames (the ROS-I xacro's joint origins and a
 ours, and its collision origins, which must be identity for the meshes to be in our link
 frames as they are); then the mesh vertices plus 20000 surface samples
 per link are tested against the union of that link's primitives in ``URDF_DIR`` (default: the
-shipped ``robots/urdf``). Prints the protrusion
-(mm), the primitives' summed volume and the mesh hull's volume (L). Skips without a checkout.
+shipped ``robots/urdf``). Prints the protrusion (mm), the volume of the primitives' union
+(Monte Carlo) and of the mesh's hull (L). Skips without a checkout.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from rosi_meshes import (
     checkout_or_exit,
     frame_differences,
     load_link_meshes,
-    primitive_volume,
     protrusion,
     surface_points,
+    union_volume,
 )
 
 SHIPPED = Path(__file__).resolve().parent.parent / "robots" / "urdf"
@@ -41,7 +41,7 @@ def main() -> None:
             f"{model}: ROS-I joint origins and axes vs ours: largest difference {joint_diff:g}; "
             f"largest collision origin offset {collision_offset:g} (0: meshes in our link frames)"
         )
-    print(f"{'model':20s} {'link':10s} {'protrusion mm':>14s} {'prims L':>8s} {'hull L':>7s}")
+    print(f"{'model':20s} {'link':10s} {'protrusion mm':>14s} {'union L':>8s} {'hull L':>7s}")
     for model in ROSI_MODELS:
         m, geom, _ = pin.buildModelsFromUrdf(str(urdf_dir / f"{model}.urdf"))
         tot_p = tot_h = 0.0
@@ -53,7 +53,7 @@ def main() -> None:
                 if g.parentFrame == fid
             ]
             out = protrusion(surface_points(mesh), prims) if prims else np.array([np.inf])
-            vol = sum(primitive_volume(g) for g, _ in prims)
+            vol = union_volume(prims)
             hull = float(mesh.convex_hull.volume)
             tot_p, tot_h = tot_p + vol, tot_h + hull
             print(

@@ -125,17 +125,6 @@ def signed_distance(geom: coal.CollisionGeometry, p: Array) -> Array:
     return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
 
 
-def primitive_volume(geom: coal.CollisionGeometry) -> float:
-    """Volume (m^3) of a coal primitive."""
-    if isinstance(geom, coal.Box):
-        return float(np.prod(2.0 * geom.halfSide))
-    if isinstance(geom, coal.Cylinder):
-        return float(np.pi * geom.radius**2 * 2.0 * geom.halfLength)
-    if isinstance(geom, coal.Capsule):
-        return float(np.pi * geom.radius**2 * (2.0 * geom.halfLength + 4.0 / 3.0 * geom.radius))
-    return float(4.0 / 3.0 * np.pi * geom.radius**3)
-
-
 def protrusion(points_link: Array, prims: list[tuple[coal.CollisionGeometry, Array]]) -> Array:
     """How far (m) each point lies outside the union of ``prims`` (geometry, T_link_prim); >= 0."""
     sd = np.full(len(points_link), np.inf)
@@ -143,3 +132,24 @@ def protrusion(points_link: Array, prims: list[tuple[coal.CollisionGeometry, Arr
         R, t = T[:3, :3], T[:3, 3]
         sd = np.minimum(sd, signed_distance(geom, (points_link - t) @ R))
     return np.maximum(sd, 0.0)
+
+
+def union_volume(prims: list[tuple[coal.CollisionGeometry, Array]], n: int = 400_000) -> float:
+    """Volume (m^3) of the union of primitives (geometry, T_link_prim), Monte Carlo over
+    their common bounding box (seeded; about 0.3 % standard error at the default ``n``)."""
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for geom, T in prims:
+        if isinstance(geom, coal.Box):
+            half = geom.halfSide
+        elif isinstance(geom, coal.Sphere):
+            half = np.full(3, geom.radius)
+        else:
+            cap = geom.radius if isinstance(geom, coal.Capsule) else 0.0
+            half = np.array([geom.radius, geom.radius, geom.halfLength + cap])
+        ext = np.abs(T[:3, :3]) @ half
+        lo, hi = np.minimum(lo, T[:3, 3] - ext), np.maximum(hi, T[:3, 3] + ext)
+    p = np.random.default_rng(0).uniform(lo, hi, (n, 3))
+    inside = np.zeros(n, bool)
+    for geom, T in prims:
+        inside |= signed_distance(geom, (p - T[:3, 3]) @ T[:3, :3]) <= 0.0
+    return float(np.prod(hi - lo) * inside.mean())

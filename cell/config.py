@@ -441,6 +441,11 @@ def _with_csv_holes(
     if not csv_path.is_absolute() and cfg.base_dir is not None:
         csv_path = cfg.base_dir / csv_path
     rows = read_holes_csv(csv_path)
+    seen = {h.id for h in cfg.part.holes}
+    for n, row in enumerate(rows, start=2):
+        if row["id"] in seen:
+            raise ConfigError(str(csv_path), [(f"row {n}, column 'id'", row["id"], "duplicate id")])
+        seen.add(str(row["id"]))
     try:
         extra = [Hole.model_validate(r) for r in rows]
     except ValidationError as exc:

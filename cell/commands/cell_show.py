@@ -46,7 +46,9 @@ def _summary(cfg: CellConfig) -> list[str]:
         f"{len(cfg.tool.shapes)} shapes",
         f"clearance arm {cfg.robot.clearance_m * 1e3:g} mm, tool {cfg.tool.clearance_m * 1e3:g} mm "
         "(to obstacles; the tool's also to the arm)",
-        f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes, "
+        f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes"
+        + (f" (with {cfg.part.holes_csv})" if cfg.part.holes_csv else "")
+        + ", "
         f"{len(cfg.part.obstacles)} obstacles",
         f"cell      {len(cfg.environment.obstacles)} environment obstacles, "
         f"{len(cfg.reference_targets)} reference targets",

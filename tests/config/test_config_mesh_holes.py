@@ -97,6 +97,8 @@ def test_holes_csv_adds_holes_in_metres(tmp_path: Path) -> None:
         (HEADER + "A,1,2,3,0,0,1,6,50\nB,1,two,3,0,0,1,6,50\n", "row 3, column 'y_mm'"),
         (HEADER + "A,1,2,3,0,0,2,6,50\n", "row 2, columns nx, ny, nz"),
         ("id,x_mm,y_mm,z_mm,nx,ny,nz\nA,1,2,3,0,0,1\n", "missing columns ['diameter']"),
+        (HEADER + "A,1,2,3,0,0,1,6,50\nA,1,2,3,0,0,1,6,50\n", "row 3, column 'id'"),
+        (HEADER + "SPL1,1,2,3,0,0,1,6,50\n", "row 2, column 'id'"),
     ],
 )
 def test_holes_csv_errors_name_file_row_and_column(tmp_path: Path, text: str, expect: str) -> None:
