@@ -130,6 +130,7 @@ class Runner(Motion):
         self.thermal = ThermalUpdate(cell, self.arm)
         self._T_head_left = invert(head_frame(camera.stereo))
         self.model_id: int | None = None
+        self.budget: BudgetContext | None = None  # set once the reference phase is over
         self._round0 = 0
         self._loaded: Tour | None = None
         self._need_load = False
@@ -154,7 +155,6 @@ class Runner(Motion):
     def _run(self, result: RunResult, wait_for_start: Callable[[], None] | None) -> None:
         stored = self.store.done_ids()
         self._restore_thermal()
-        self.budget = self._budget_context()
         self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
         if wait_for_start is not None:
             wait_for_start()
@@ -165,6 +165,7 @@ class Runner(Motion):
             self._home_for_reference()
             self._reference_phase()
             result.thermal = self._identify()
+        self.budget = self._budget_context()  # after the cold readings: no delay before them
         self._state("inspecting")
         self._load(self.tour)
         for k in todo:
