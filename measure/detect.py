@@ -133,7 +133,14 @@ def _levels(small: np.ndarray):
         yield "bright", [p_hi - f * (p_hi - p_med) for f in LADDER], p_hi
 
 
-def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, reach) -> list[tuple]:
+def _discs(
+    mask: np.ndarray,
+    min_area: float,
+    level: int,
+    border_only: bool,
+    reach,
+    tally: list[int] | None = None,
+) -> list[tuple]:
     """Disc-like outer regions of a mask: (cx, cy, area, bbox, border, level) in search px.
 
     Outlines shorter than the smallest disc's perimeter, or filling their box far less
@@ -168,6 +175,8 @@ def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, rea
             continue
         if reach(x, y, w, h) < 0.5:
             continue
+        if tally is not None:
+            tally[0] += 1
         if _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
             out.append((m["m10"] / area, m["m01"] / area, area, (x, y, w, h), border, level))
             continue
@@ -276,11 +285,14 @@ def find_candidates(
     small: np.ndarray,
     roi: tuple[int, int, int, int] | None = None,
     min_diameter_px: float = 16.0,
+    stats: dict | None = None,
 ) -> list[HoleCandidate]:
     """Disc-like dark regions (else bright ones) in the search image (optionally in ``roi``).
 
     ``small`` is the search image of :func:`check_image`; ``roi`` and the returned
-    coordinates are full-resolution pixels.
+    coordinates are full-resolution pixels. ``stats``, when given, receives what decided:
+    ``contrast`` per class (fraction of full scale from the extreme to the median; a class
+    is searched from 0.2) and ``regions`` (compact regions that got the disc test).
     """
     ox, oy = 0, 0
     s = SEARCH_SCALE
@@ -294,17 +306,22 @@ def find_candidates(
     min_area = np.pi * (0.5 * min_diameter_px / s) ** 2
     small = cv2.medianBlur(small, 3)  # texture and noise specks would each be an outline
     found = {}
+    tally = [0]
+    if stats is not None:
+        p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
+        stats["contrast"] = {"dark": (p_med - p_lo) / 255.0, "bright": (p_hi - p_med) / 255.0}
     for border_only in (False, True):  # regions cut by the border only when nothing else
         for polarity, thresholds, extreme in _levels(small):
             discs = []
             for k, thr in enumerate(thresholds):
                 mask = (small <= thr) if polarity == "dark" else (small > thr)
-                discs += _discs(
-                    mask, min_area, k, border_only, _reach(small, polarity, thr, extreme)
-                )
+                reach = _reach(small, polarity, thr, extreme)
+                discs += _discs(mask, min_area, k, border_only, reach, tally)
             found[polarity] = (thresholds, _group(discs))
         if any(holes for _, holes in found.values()):
             break
+    if stats is not None:
+        stats["regions"] = tally[0]
     _cross_polarity(found)
     bores = _bores_in_bright_rings(small, found, min_area, (ox, oy))
     if bores:
