@@ -73,6 +73,7 @@ def check_image(img: np.ndarray, which: str) -> tuple[float, np.ndarray]:
     level and the 8-bit search image (every 4th pixel). Messages give the figures that
     decided.
     """
+    img = to_gray(img, which)
     h, w = img.shape
     if min(h, w) < 64:
         raise ImageError(which, f"too small ({w}x{h} px; at least 64 px each side needed)")
