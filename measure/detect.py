@@ -188,9 +188,10 @@ def _discs(
 
 
 def _plateau(members: list[tuple]) -> tuple:
-    """The member in the middle of the longest run of levels with the same diameter (of
-    equally long runs the darkest, unless they are single levels: then the largest region,
-    the rim around a patchy interior), plus the run length and the other runs' middles."""
+    """The member in the middle of the longest run of levels with the same diameter (the
+    darkest run at most one level shorter, since a chamfer ring joins the bore at the
+    higher levels; when all runs are single levels, the largest region: the rim around a
+    patchy interior), plus the run length and the other runs' middles."""
     members = sorted(members, key=lambda m: m[5])
     runs: list[list[tuple]] = [[members[0]]]
     for m in members[1:]:
@@ -203,8 +204,8 @@ def _plateau(members: list[tuple]) -> tuple:
     longest = max(len(r) for r in runs)
     if longest == 1:
         best = max(runs, key=lambda r: r[0][2])
-    else:
-        best = next(r for r in runs if len(r) == longest)
+    else:  # the darkest run nearly as long: a chamfer ring joins the bore at higher levels
+        best = next(r for r in runs if len(r) >= longest - 1 and len(r) >= 2)
     others = tuple(r[len(r) // 2] for r in runs if r is not best)
     return best[len(best) // 2] + (len(best), others)
 
