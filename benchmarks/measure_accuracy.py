@@ -89,7 +89,7 @@ REALISTIC = RenderOptions(
 )
 REALISTIC_TARGET = {"bias": 5.0, "std": 5.0, "center": 15.0, "normal": 0.2}
 #: rounded lips of growing size: the bias is documented, not a target
-LIPS = {f"rounded lip {v * 1e3:g} mm": v for v in (0.05, 0.1, 0.2)}
+LIPS = {f"lip {v:g} mm": v * 1e-3 for v in (0.05, 0.1, 0.2)}
 GROUPS = ("standard", "robustness", "ladder", "realistic", "lips")
 
 

@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
-from measure.detect import check_image, find_candidates
+from measure.detect import check_image, find_candidates, to_gray
 from measure.edges import hole_region, outline_band
 from measure.errors import EdgeError, HoleNotFoundError
 from measure.triangulate import triangulate_dlt
@@ -34,6 +34,7 @@ class BaselineResult:
 
 
 def _ellipse(img: np.ndarray, which: str):
+    img = to_gray(img, which)
     full, small = check_image(img, which)
     cands = [c for c in find_candidates(small) if not c.touches_border]
     if not cands:

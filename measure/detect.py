@@ -18,8 +18,7 @@ one goes), the bore wall's crescent beside a lit background when not (the dark o
 Regions cut by the border are kept and flagged, so the caller can say so instead of
 "no hole".
 
-Images may be ``uint8`` or ``uint16`` holding 8 to 16 significant bits, single-channel or
-colour (converted to luma); see :func:`to_gray` and :func:`full_scale`.
+Input types and exposure checks are in :mod:`measure.image_input`.
 """
 
 from __future__ import annotations
@@ -29,10 +28,26 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from measure.errors import ImageError
+from measure.image_input import (
+    SEARCH_SCALE,
+    check_image,
+    full_scale,
+    quantiles_u8,
+    to_gray,
+    to_search_image,
+)
 
-#: downsampling factor of the search image
-SEARCH_SCALE = 4
+__all__ = [
+    "SEARCH_SCALE",
+    "HoleCandidate",
+    "check_image",
+    "find_candidates",
+    "full_scale",
+    "quantiles_u8",
+    "to_gray",
+    "to_search_image",
+    "without_bites",
+]
 #: fractions of the way from the darkest pixels to the median at which the ladder thresholds
 LADDER = (0.25, 0.4, 0.55, 0.7, 0.85)
 #: relative diameter change that still counts as "the same region" between ladder levels
@@ -58,93 +73,6 @@ class HoleCandidate:
     touches_border: bool
     levels: int = 1
     alternates: tuple[HoleCandidate, ...] = ()
-
-
-def to_gray(img: object, which: str) -> np.ndarray:
-    """The single-channel image ``measure_hole`` works on.
-
-    Accepts 2-D arrays and colour arrays ``(h, w, 3|4)`` (BGR or BGRA, as OpenCV reads
-    them; converted to luma) or ``(h, w, 1)``, of ``uint8`` or ``uint16``. Anything else
-    raises :class:`ImageError` naming what was given.
-    """
-    if not isinstance(img, np.ndarray):
-        raise ImageError(which, f"must be a numpy array, got {type(img).__name__}")
-    if img.dtype not in (np.uint8, np.uint16):
-        raise ImageError(which, f"must be uint8 or uint16, got {img.dtype}")
-    if img.ndim == 3 and img.shape[2] == 1:
-        img = img[:, :, 0]
-    elif img.ndim == 3 and img.shape[2] in (3, 4):
-        img = cv2.cvtColor(np.ascontiguousarray(img[:, :, :3]), cv2.COLOR_BGR2GRAY)
-    if img.ndim != 2:
-        raise ImageError(
-            which, f"must be single-channel (h, w) or colour (h, w, 3), got shape {img.shape}"
-        )
-    return img
-
-
-def full_scale(img: np.ndarray) -> float:
-    """Full-scale gray level: 255 for uint8; for uint16 the smallest 2^k − 1 (k = 8, 10,
-    12, 14, 16) at or above the image maximum (sensors deliver 8 … 16 significant bits)."""
-    if img.dtype == np.uint8:
-        return 255.0
-    top = int(img.max())
-    for bits in (8, 10, 12, 14):
-        if top <= (1 << bits) - 1:
-            return float((1 << bits) - 1)
-    return 65535.0
-
-
-def quantiles_u8(img: np.ndarray, qs: tuple[float, ...]) -> list[float]:
-    """Quantiles (0..1) of a uint8 image from its histogram (far cheaper than sorting)."""
-    hist = cv2.calcHist([img], [0], None, [256], [0, 256]).ravel()
-    cdf = np.cumsum(hist) / img.size
-    return [float(np.searchsorted(cdf, q)) for q in qs]
-
-
-def to_search_image(img: np.ndarray, full: float) -> np.ndarray:
-    """Every 4th pixel in each direction, as uint8 (0.2 ms for 5 MP); the hole is a big blob."""
-    o = SEARCH_SCALE // 2 if min(img.shape) > SEARCH_SCALE * 8 else 0
-    small = img[o::SEARCH_SCALE, o::SEARCH_SCALE]
-    if small.dtype != np.uint8:
-        small = np.clip(small.astype(np.float32) * (255.0 / full), 0, 255).astype(np.uint8)
-    return np.ascontiguousarray(small)
-
-
-def check_image(img: np.ndarray, which: str) -> tuple[float, np.ndarray]:
-    """Reject unusable images (type, shape, size, saturated, black, flat).
-
-    ``img`` is the single-channel image of :func:`to_gray`. Returns the full-scale gray
-    level and the 8-bit search image (every 4th pixel). Messages give the figures that
-    decided.
-    """
-    h, w = img.shape
-    if min(h, w) < 64:
-        raise ImageError(which, f"too small ({w}x{h} px; at least 64 px each side needed)")
-    full = full_scale(img)
-    small = to_search_image(img, full)
-    n = small.size
-    n_sat = int(np.count_nonzero(small >= 254))
-    if n_sat > 0.5 * n:
-        raise ImageError(
-            which,
-            f"saturated: {n_sat / n:.0%} of the pixels are at full scale "
-            f"({full:.0f}; at most 50 % allowed)",
-        )
-    p1, p99 = quantiles_u8(small, (0.01, 0.99))
-    if p99 < 0.04 * 255:
-        raise ImageError(
-            which,
-            f"black: 99 % of the pixels are at or below gray level "
-            f"{p99 / 255 * full:.0f} of {full:.0f} ({p99 / 255:.1%} of full scale; "
-            "the brightest 1 % must reach 4 %)",
-        )
-    if p99 - p1 < 0.05 * 255:
-        raise ImageError(
-            which,
-            f"no contrast: 98 % of the pixels lie within {(p99 - p1) / 255:.1%} of full "
-            "scale (at least 5 % needed)",
-        )
-    return full, small
 
 
 def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray | None:
@@ -205,7 +133,14 @@ def _levels(small: np.ndarray):
         yield "bright", [p_hi - f * (p_hi - p_med) for f in LADDER], p_hi
 
 
-def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, reach) -> list[tuple]:
+def _discs(
+    mask: np.ndarray,
+    min_area: float,
+    level: int,
+    border_only: bool,
+    reach,
+    tally: list[int] | None = None,
+) -> list[tuple]:
     """Disc-like outer regions of a mask: (cx, cy, area, bbox, border, level) in search px.
 
     Outlines shorter than the smallest disc's perimeter, or filling their box far less
@@ -240,6 +175,8 @@ def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, rea
             continue
         if reach(x, y, w, h) < 0.5:
             continue
+        if tally is not None:
+            tally[0] += 1
         if _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
             out.append((m["m10"] / area, m["m01"] / area, area, (x, y, w, h), border, level))
             continue
@@ -251,9 +188,10 @@ def _discs(mask: np.ndarray, min_area: float, level: int, border_only: bool, rea
 
 
 def _plateau(members: list[tuple]) -> tuple:
-    """The member in the middle of the longest run of levels with the same diameter (of
-    equally long runs the darkest, unless they are single levels: then the largest region,
-    the rim around a patchy interior), plus the run length and the other runs' middles."""
+    """The member in the middle of the longest run of levels with the same diameter (the
+    darkest run at most one level shorter, since a chamfer ring joins the bore at the
+    higher levels; when all runs are single levels, the largest region: the rim around a
+    patchy interior), plus the run length and the other runs' middles."""
     members = sorted(members, key=lambda m: m[5])
     runs: list[list[tuple]] = [[members[0]]]
     for m in members[1:]:
@@ -266,8 +204,8 @@ def _plateau(members: list[tuple]) -> tuple:
     longest = max(len(r) for r in runs)
     if longest == 1:
         best = max(runs, key=lambda r: r[0][2])
-    else:
-        best = next(r for r in runs if len(r) == longest)
+    else:  # the darkest run nearly as long: a chamfer ring joins the bore at higher levels
+        best = next(r for r in runs if len(r) >= longest - 1 and len(r) >= 2)
     others = tuple(r[len(r) // 2] for r in runs if r is not best)
     return best[len(best) // 2] + (len(best), others)
 
@@ -348,11 +286,14 @@ def find_candidates(
     small: np.ndarray,
     roi: tuple[int, int, int, int] | None = None,
     min_diameter_px: float = 16.0,
+    stats: dict | None = None,
 ) -> list[HoleCandidate]:
     """Disc-like dark regions (else bright ones) in the search image (optionally in ``roi``).
 
     ``small`` is the search image of :func:`check_image`; ``roi`` and the returned
-    coordinates are full-resolution pixels.
+    coordinates are full-resolution pixels. ``stats``, when given, receives what decided:
+    ``contrast`` per class (fraction of full scale from the extreme to the median; a class
+    is searched from 0.2) and ``regions`` (compact regions that got the disc test).
     """
     ox, oy = 0, 0
     s = SEARCH_SCALE
@@ -366,17 +307,22 @@ def find_candidates(
     min_area = np.pi * (0.5 * min_diameter_px / s) ** 2
     small = cv2.medianBlur(small, 3)  # texture and noise specks would each be an outline
     found = {}
+    tally = [0]
+    if stats is not None:
+        p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
+        stats["contrast"] = {"dark": (p_med - p_lo) / 255.0, "bright": (p_hi - p_med) / 255.0}
     for border_only in (False, True):  # regions cut by the border only when nothing else
         for polarity, thresholds, extreme in _levels(small):
             discs = []
             for k, thr in enumerate(thresholds):
                 mask = (small <= thr) if polarity == "dark" else (small > thr)
-                discs += _discs(
-                    mask, min_area, k, border_only, _reach(small, polarity, thr, extreme)
-                )
+                reach = _reach(small, polarity, thr, extreme)
+                discs += _discs(mask, min_area, k, border_only, reach, tally)
             found[polarity] = (thresholds, _group(discs))
         if any(holes for _, holes in found.values()):
             break
+    if stats is not None:
+        stats["regions"] = tally[0]
     _cross_polarity(found)
     bores = _bores_in_bright_rings(small, found, min_area, (ox, oy))
     if bores:

@@ -44,15 +44,30 @@ def _rois(roi) -> tuple[Rect | None, Rect | None]:
     raise ValueError(f"roi must be (x, y, w, h) or a pair of them, got {roi!r}")
 
 
-def _usable(cands: list[HoleCandidate], which: str, roi: Rect | None, shape) -> list[HoleCandidate]:
+def _usable(
+    cands: list[HoleCandidate], which: str, roi: Rect | None, shape, stats: dict
+) -> list[HoleCandidate]:
     inner = [c for c in cands if not c.touches_border]
     if inner:
         return inner
     if cands:
         raise HoleAtBorderError(which, cands[0].bbox)
     where = f" in the region {roi}" if roi is not None else ""
+    con = stats.get("contrast", {})
+    searched = [k for k, v in con.items() if v >= 0.2]
+    if searched:
+        why = (
+            f"{stats.get('regions', 0)} compact regions of the "
+            f"{' and '.join(searched)} class{'es' if len(searched) > 1 else ''} at five "
+            "threshold levels, none disc-like"
+        )
+    else:
+        why = (
+            f"too little contrast to search: dark {con.get('dark', 0.0):.0%}, bright "
+            f"{con.get('bright', 0.0):.0%} of full scale from the median (20 % needed)"
+        )
     raise HoleNotFoundError(
-        which, f"no dark or bright disc-like region{where} ({shape[1]}x{shape[0]} px)"
+        which, f"no dark or bright disc-like region{where} ({shape[1]}x{shape[0]} px): {why}"
     )
 
 
@@ -203,8 +218,9 @@ def measure_hole(
     full_r, small_r = check_image(right, "right")
     stereo.check_image(left.shape, "left")
     roi_l, roi_r = _rois(roi)
-    cand_l = _usable(find_candidates(small_l, roi_l), "left", roi_l, left.shape)
-    cand_r = _usable(find_candidates(small_r, roi_r), "right", roi_r, right.shape)
+    st_l, st_r = {}, {}
+    cand_l = _usable(find_candidates(small_l, roi_l, stats=st_l), "left", roi_l, left.shape, st_l)
+    cand_r = _usable(find_candidates(small_r, roi_r, stats=st_r), "right", roi_r, right.shape, st_r)
     cl, cr, check = pick_pair(
         cand_l, cand_r, stereo, expected_diameter_m, opts.size_tolerance, expected_standoff_m
     )
