@@ -196,7 +196,7 @@ def test_large_images_are_searched_scaled_down_and_refined_at_full_resolution():
     det = find_target(big, BOARD)
     assert det.reason == "" and det.detector == "fast"
     # found on the scaled copy, refined in the full-resolution image: the same corners
-    np.testing.assert_allclose(det.points, small.points + [300, 200], atol=0.02)
+    np.testing.assert_allclose(det.points, small.points + np.array([300.0, 200.0]), atol=0.02)
 
 
 def test_left_and_right_grids_turned_by_180_degrees_are_put_in_one_order():
