@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
-from measure.target import TargetSpec, to_gray8
+from measure.target import TargetSpec, detection_copy, to_gray8
 
 _SB_LARGER = (
     cv2.CALIB_CB_LARGER
@@ -65,9 +65,8 @@ def board_size_census(
         return votes
     picks = np.unique(np.linspace(0, len(images) - 1, min(n_views, len(images))).round())
     for k in picks.astype(int):
-        found, _, meta = cv2.findChessboardCornersSBWithMeta(
-            to_gray8(images[k]), (4, 4), flags=_SB_LARGER
-        )
+        small, _ = detection_copy(to_gray8(images[k]))
+        found, _, meta = cv2.findChessboardCornersSBWithMeta(small, (4, 4), flags=_SB_LARGER)
         if found and meta is not None:
             a, b = meta.shape[:2]
             votes[(max(a, b), min(a, b))] += 1

@@ -222,6 +222,8 @@ def _bootstrap_std(used, spec, size, sol: _Solution, n_boot: int, seed: int) -> 
             [K[0, 0], K[1, 1], K[0, 2], K[1, 2], *np.ravel(d)[:4]] for K, d in ((K1, d1), (K2, d2))
         ]
         rows.append([*cams[0], *cams[1], *cv2.Rodrigues(R)[0].ravel(), *np.ravel(T)])
+    if len(rows) < 2:  # nothing to learn from: the Jacobian figures stand
+        return np.zeros(22)
     return np.std(np.asarray(rows), axis=0, ddof=1)
 
 

@@ -125,16 +125,37 @@ def find_target(gray: np.ndarray, spec: TargetSpec) -> TargetDetection:
     return TargetDetection(pts.astype(np.float64), "", detector)
 
 
+#: chessboards are searched on a copy scaled to at most this many pixels on the longest side
+#: (5-megapixel images cost OpenCV's detectors seconds, a minute when there is no board), then
+#: the corners are refined at full resolution
+DETECT_MAX_SIDE_PX = 1280
+
+
+def detection_copy(img: np.ndarray) -> tuple[np.ndarray, float]:
+    """``img`` scaled to at most :data:`DETECT_MAX_SIDE_PX` (INTER_AREA) and the scale."""
+    scale = min(1.0, DETECT_MAX_SIDE_PX / max(img.shape[:2]))
+    if scale == 1.0:
+        return img, 1.0
+    return cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA), scale
+
+
 def _find_chessboard(img: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray | None, str]:
     crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4)
+    small, scale = detection_copy(img)
+
+    def full_res(pts: np.ndarray) -> np.ndarray:
+        # pixel centres: x_full + 0.5 = (x_small + 0.5) / scale
+        return ((pts.astype(np.float32) + 0.5) / scale - 0.5).astype(np.float32)
+
     for detector, flags in (("fast", _CLASSIC | cv2.CALIB_CB_FAST_CHECK), ("plain", _CLASSIC)):
-        found, pts = cv2.findChessboardCorners(img, size, flags=flags)
+        found, pts = cv2.findChessboardCorners(small, size, flags=flags)
         if found and pts is not None:
-            return cv2.cornerSubPix(img, pts, (5, 5), (-1, -1), crit), detector
-    # the SB detector's corners are already sub-pixel (CALIB_CB_ACCURACY)
-    found, pts = cv2.findChessboardCornersSB(img, size, flags=_SB)
+            return cv2.cornerSubPix(img, full_res(pts), (5, 5), (-1, -1), crit), detector
+    found, pts = cv2.findChessboardCornersSB(small, size, flags=_SB)
     if found and pts is not None:
-        return pts, "sb"
+        if scale == 1.0:  # already sub-pixel (CALIB_CB_ACCURACY)
+            return pts, "sb"
+        return cv2.cornerSubPix(img, full_res(pts), (5, 5), (-1, -1), crit), "sb"
     return None, ""
 
 

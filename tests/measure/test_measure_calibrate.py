@@ -112,6 +112,8 @@ def test_cli_writes_stereo_json(tmp_path, capsys):
         "0.0022",
         "-o",
         str(out),
+        "--bootstrap",
+        "10",
     ]
     assert main(args) == 0
     text = capsys.readouterr().out

@@ -183,3 +183,26 @@ def test_cli_refuses_the_millimetre_pitch_and_writes_uncertainties(tmp_path, cap
     assert StereoCalibration.load(out).uncertainty.T_std_m[0] > 0
     assert main([*base, "--pitch", "3", "--force", "-o", str(tmp_path / "forced.json")]) == 0
     assert StereoCalibration.load(tmp_path / "forced.json").baseline_m > 50
+
+
+def test_large_images_are_searched_scaled_down_and_refined_at_full_resolution():
+    from measure.target import DETECT_MAX_SIDE_PX
+
+    _, left, _ = _board_pairs()[0]
+    big = np.full((1100, 1500), 64, np.uint8)  # the 640×512 view inside a larger frame
+    big[200:712, 300:940] = left
+    assert max(big.shape) > DETECT_MAX_SIDE_PX
+    small = find_target(left, BOARD)
+    det = find_target(big, BOARD)
+    assert det.reason == "" and det.detector == "fast"
+    # found on the scaled copy, refined in the full-resolution image: the same corners
+    np.testing.assert_allclose(det.points, small.points + np.array([300.0, 200.0]), atol=0.02)
+
+
+def test_left_and_right_grids_turned_by_180_degrees_are_put_in_one_order():
+    from measure.stereo_calibrate import _orient
+
+    _, left, right = _board_pairs()[1]
+    pl, pr = find_target(left, BOARD).points, find_target(right, BOARD).points
+    np.testing.assert_array_equal(_orient(pl, pr[::-1], BOARD), pr)
+    np.testing.assert_array_equal(_orient(pl, pr, BOARD), pr)
