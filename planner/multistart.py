@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import gc
+import logging
 import time
 
 from planner.engines import Engine, LocalEngine
@@ -33,6 +34,8 @@ def start_seeds(options: Options, starts: int) -> list[int]:
 def plan_one(cell: CellLike, options: Options) -> Tour | str:
     """One start (runs in a worker): the tour (``settings["cpu_time_s"]``: the CPU time of
     the start, every thread), or the planning error's message."""
+    # the summary lists holes left out once; the starts need not warn about them each
+    logging.getLogger("planner").setLevel(logging.ERROR)
     cpu = time.process_time()
     try:
         tour = TourPlanner(options).plan(cell)
