@@ -19,12 +19,12 @@ test: $(STAMP)
 	$(PY) -m pytest -q
 
 lint: $(STAMP)
-	$(VENV)/bin/ruff check cell planner measure robots tests benchmarks
-	$(VENV)/bin/ruff format --check cell planner measure robots tests benchmarks
+	$(VENV)/bin/ruff check cell planner measure robots tests benchmarks examples
+	$(VENV)/bin/ruff format --check cell planner measure robots tests benchmarks examples
 
 format: $(STAMP)
-	$(VENV)/bin/ruff format cell planner measure robots tests benchmarks
-	$(VENV)/bin/ruff check --fix cell planner measure robots tests benchmarks
+	$(VENV)/bin/ruff format cell planner measure robots tests benchmarks examples
+	$(VENV)/bin/ruff check --fix cell planner measure robots tests benchmarks examples
 
 bench: $(STAMP)
 	for f in benchmarks/*.py; do $(PY) $$f || exit 1; done
