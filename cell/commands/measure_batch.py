@@ -56,6 +56,9 @@ CSV_COLUMNS = (
     "n_rejected",
     "n_filled",
     "time_s",
+    "rms_um",
+    "suspect_reasons",
+    "rim",
 )
 
 
@@ -179,6 +182,9 @@ def measure_pairs(entries, stereo, diameter_m, opts, progress=None) -> list[dict
                     n_rejected=m.n_rejected,
                     n_filled=m.n_filled,
                     time_s=m.time_s,
+                    rms_um=m.rms_m * 1e6,
+                    suspect_reasons="; ".join(m.suspect_reasons),
+                    rim="" if m.rim is None else m.rim.describe(),
                 )
                 for axis, c, n in zip("xyz", m.center_m, m.normal, strict=True):
                     row[f"center_{axis}_m"] = float(c)
@@ -266,4 +272,5 @@ def _print_table(rows: list[dict[str, Any]]) -> None:
             print(f"{r['id']:<{width}}  error    {'':>11}  {'':>7}  {r['reason']}")
         else:
             d, rms = r["diameter_m"] * 1e3, r["rms_m"] * 1e6
-            print(f"{r['id']:<{width}}  {r['status']:<7}  {d:11.4f}  {rms:7.2f}")
+            why = r["suspect_reasons"]
+            print(f"{r['id']:<{width}}  {r['status']:<7}  {d:11.4f}  {rms:7.2f}  {why}".rstrip())

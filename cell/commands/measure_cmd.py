@@ -72,11 +72,15 @@ def _table(m) -> str:
         ("diameter", f"{m.diameter_m * 1e3:.4f} mm"),
         ("centre (left cam)", f"{c[0]:.4f}  {c[1]:.4f}  {c[2]:.4f} mm"),
         ("normal", "  ".join(f"{v:+.5f}" for v in m.normal)),
-        ("rms residual", f"{m.rms_m * 1e3:.4f} mm"),
+        ("rms residual", f"{m.rms_m * 1e3:.4f} mm ({m.rms_m * 1e6:.1f} µm)"),
         ("σ(radius)", f"{np.sqrt(m.cov_center_radius[3, 3]) * 1e3:.5f} mm"),
         ("points used/rejected/filled", f"{m.n_points} / {m.n_rejected} / {m.n_filled}"),
         ("time", f"{m.time_s * 1e3:.1f} ms"),
     ]
+    if m.rim is not None:
+        rows.insert(1, ("rim", m.rim.describe()))
+    for k, reason in enumerate(m.suspect_reasons):
+        rows.insert(1 + k, ("suspect because" if k == 0 else "", reason))
     width = max(len(k) for k, _ in rows)
     return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
 

@@ -65,3 +65,31 @@ def test_errors_are_one_line(tmp_path, capsys):
     assert "no such file" in capsys.readouterr().err
     assert main(["measure", str(tmp_path / "nope.png"), right, "--stereo", stereo]) == 2
     assert "nope.png" in capsys.readouterr().err
+
+
+def test_table_and_batch_rows_name_the_rim_and_the_suspect_reasons(tmp_path, capsys):
+    from cell.commands.measure_batch import CSV_COLUMNS, PairEntry, measure_pairs
+    from cell.commands.measure_cmd import _table
+    from measure import MeasureOptions, measure_hole
+
+    r = render(0.008, 10.0, 25)
+    left, right, stereo = _write_pair(tmp_path, r)
+    assert main(["measure", left, right, "--stereo", stereo]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    rim = next(ln for ln in lines if ln.startswith("rim "))
+    assert "dark interior" in rim and "px (left / right)" in rim
+    assert "µm)" in next(ln for ln in lines if ln.startswith("rms residual"))
+    assert not any(ln.startswith("suspect because") for ln in lines)
+    # a fit-RMS limit no real fit meets: the table and the batch row say why it is suspect
+    strict = MeasureOptions(suspect_rms_m=1e-9, suspect_rms_px=1e-6)
+    m = measure_hole(r.left, r.right, small_stereo(), options=strict)
+    assert m.status == "suspect" and m.suspect_reasons
+    table = _table(m)
+    why = next(ln for ln in table.splitlines() if ln.startswith("suspect because"))
+    assert why.endswith(m.suspect_reasons[0]) and "fit RMS" in why
+    entry = PairEntry("H1", tmp_path / "left.png", tmp_path / "right.png")
+    (row,) = measure_pairs([entry], small_stereo(), None, strict)
+    assert {"rms_um", "suspect_reasons", "rim"} <= set(CSV_COLUMNS)
+    assert row["status"] == "suspect" and "fit RMS" in row["suspect_reasons"]
+    assert abs(row["rms_um"] - row["rms_m"] * 1e6) < 1e-9 and "dark interior" in row["rim"]
+    assert row["_result"]["suspect_reasons"] == list(m.suspect_reasons)
