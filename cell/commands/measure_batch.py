@@ -8,7 +8,9 @@ Pairing (decided here, documented in docs/measure.md):
 - any other ``DIR``: image files whose name (without extension) starts or ends with ``left`` /
   ``right`` (any case; a ``_``, ``-``, ``.`` or space next to it is dropped): ``H01_left.png`` +
   ``H01_right.png``, ``left_H01.png`` + ``right_H01.png``, ``left01.jpg`` + ``right01.jpg``;
-  the rest of the name is the id. Other files are ignored.
+  the rest of the name is the id; else ``left``/``right`` as a word inside the name, between a
+  separator and a digit or separator (``raw_left1.png`` + ``raw_right1.png`` → ``raw_1``).
+  Other files are ignored.
 - a list file: one pair per line, ``LEFT RIGHT [ID]`` (shell quoting for spaces), ``#``
   comments and blank lines ignored, relative paths relative to the list file.
 
@@ -37,6 +39,9 @@ IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".pgm", ".pp
 _SIDE = re.compile(
     r"^(?:(?P<pre>left|right)[_\-. ]?(?P<a>.*)|(?P<b>.*?)[_\-. ]?(?P<post>left|right))$", re.I
 )
+# ``raw_left1`` / ``raw_right1`` (the ZED tools' names): the side as a word inside the name,
+# after a separator and before a digit or a separator; the id keeps the rest (``raw_1``).
+_SIDE_INSIDE = re.compile(r"^(?P<a>.+?[_\-. ])(?P<side>left|right)(?P<b>(?=[0-9_\-. ]).+)$", re.I)
 
 CSV_COLUMNS = (
     "id",
@@ -75,7 +80,10 @@ class PairEntry:
 def _side_and_id(stem: str) -> tuple[str, str] | None:
     m = _SIDE.match(stem)
     if not m:
-        return None
+        inside = _SIDE_INSIDE.match(stem)
+        if inside is None:
+            return None
+        return inside.group("side").lower(), inside.group("a") + inside.group("b")
     if m.group("pre"):
         return m.group("pre").lower(), m.group("a")
     return m.group("post").lower(), m.group("b")

@@ -36,9 +36,9 @@ def register(sub: argparse._SubParsersAction) -> None:
             "frame. Writes nothing. With --pairs DIR|LIST instead of LEFT RIGHT: every pair "
             "of a folder (left/ and right/ subfolders with the same file names, or names "
             "starting or ending with left/right: H01_left.png + H01_right.png, left01.jpg + "
-            "right01.jpg) or of a list file (LEFT RIGHT [ID] per line, # comments) in one "
-            "process, with a progress bar; a pair that fails is reported in its row "
-            "(exit code 1) and the batch goes on; -o writes one row per pair (.csv or .json)."
+            "right01.jpg, raw_left1.png + raw_right1.png) or of a list file (LEFT RIGHT [ID] "
+            "per line, # comments) in one process, with a progress bar; a pair that fails is "
+            "reported in its row (exit code 1) and the batch goes on; -o writes one row per pair (.csv or .json)."
         ),
     )
     p.add_argument("left", nargs="?", help="left camera image")

@@ -86,10 +86,16 @@ def test_pairing_rules(tmp_path, capsys):
     assert got == {"0001": "", "0002": "no right image"}
     flat = tmp_path / "b"
     flat.mkdir()
-    for name in ("left01.jpg", "right01.jpg", "H7-Left.PNG", "H7-Right.png", "x.png"):
+    names = ("left01.jpg", "right01.jpg", "H7-Left.PNG", "H7-Right.png", "x.png")
+    names += ("raw_left1.png", "raw_right1.png", "a_bright2.png", "c_leftover.png")
+    for name in names:
         (flat / name).write_bytes(b"")
     got = {e.pair_id: (e.left.name, e.right.name) for e in collect_pairs(str(flat))}
-    assert got == {"01": ("left01.jpg", "right01.jpg"), "H7": ("H7-Left.PNG", "H7-Right.png")}
+    assert got == {
+        "01": ("left01.jpg", "right01.jpg"),
+        "H7": ("H7-Left.PNG", "H7-Right.png"),
+        "raw_1": ("raw_left1.png", "raw_right1.png"),
+    }
     st = _stereo(tmp_path)
     assert main(["measure", "--pairs", str(tmp_path / "none"), "--stereo", st]) == 2
     assert "no such folder or list file" in capsys.readouterr().err
