@@ -38,7 +38,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "starting or ending with left/right: H01_left.png + H01_right.png, left01.jpg + "
             "right01.jpg, raw_left1.png + raw_right1.png) or of a list file (LEFT RIGHT [ID] "
             "per line, # comments) in one process, with a progress bar; a pair that fails is "
-            "reported in its row (exit code 1) and the batch goes on; -o writes one row per pair (.csv or .json)."
+            "reported in its row (exit code 1) and the batch goes on; -o writes one row per "
+            "pair (.csv or .json)."
         ),
     )
     p.add_argument("left", nargs="?", help="left camera image")
