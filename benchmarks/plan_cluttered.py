@@ -64,7 +64,12 @@ def _stats(values: list[float]) -> dict[str, float]:
 
 
 def run_instance(
-    name: str, engine: LocalEngine, seeds: int, quick: bool, minimal: bool = False
+    name: str,
+    engine: LocalEngine,
+    seeds: int,
+    quick: bool,
+    minimal: bool = False,
+    long_runs: bool = True,
 ) -> dict:
     """Every run of one instance (see module docstring); cycle times in s.
 
@@ -106,7 +111,7 @@ def run_instance(
         out["runs"][seq] = [_row(s, r) for s, r in enumerate(res)]
         print(f"  {cell.name} {seq}: {[r['cycle_s'] for r in out['runs'][seq]]}", file=sys.stderr)
     n = len(cell.part.holes)
-    for seq in SEQUENCERS:
+    for seq in SEQUENCERS if long_runs else ():
         if minimal and seq == "ortools":
             continue
         long_seeds = [0] if seq == "ortools" or quick or minimal else [0, 1]
@@ -183,6 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=8)
     ap.add_argument("--quick", action="store_true", help="4 seeds per sequencer, one long run")
     ap.add_argument("--minimal", action="store_true", help="see run_instance")
+    ap.add_argument("--no-long", action="store_true", help="skip the 20x runs")
     ap.add_argument("--jobs", type=int, default=None)
     ap.add_argument("--json", type=Path, default=None)
     ap.add_argument("--timing-only", nargs="*", default=None, help="plan these once, time it")
@@ -207,7 +213,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     results = []
     for name in args.instances:
-        results.append(run_instance(name, engine, args.seeds, args.quick, args.minimal))
+        results.append(
+            run_instance(name, engine, args.seeds, args.quick, args.minimal, not args.no_long)
+        )
         if args.json:
             args.json.write_text(json.dumps(results, indent=1))
         print(f"load average after {name}: {os.getloadavg()}", file=sys.stderr)
