@@ -6,9 +6,9 @@ of one pose, for each built-in model. Targets: collision check <= 30 us on the
 default cell, all IK branches <= 100 us.
 
 Then the same cell with an arm given by a URDF with collision meshes: arm load
-time (<= 1 s CPU), ``in_collision`` (<= 30 us) and IK of the URDF-derived OPW
-model (<= 100 us). ``--mesh-urdf`` names that URDF (e.g. the ROS-Industrial
-IRB 2600, expanded from xacro, with ``--package-path`` for its package://
+time (<= 1 s CPU), ``in_collision`` (<= 30 us, with the cell's clearances) and
+IK of the URDF-derived OPW model (<= 100 us). ``--mesh-urdf`` names that URDF (e.g.
+the ROS-Industrial IRB 2600, expanded from xacro, with ``--package-path`` for its package://
 meshes); without it, the built-in IRB 2600 with every primitive turned into a
 triangle mesh (generated here, in a temporary folder) is used. The table says
 which. The mesh check is cross-checked against the exhaustive pair test.
@@ -64,6 +64,7 @@ def _mesh_rows(args: argparse.Namespace, rng: np.random.Generator) -> list[tuple
         loads.append(time.process_time() - t0)
     arm.set_tool(cfg.T_tool0_tcp(), cfg.tool_shapes())
     arm.add_obstacles(cfg.obstacle_shapes())
+    arm.set_clearance(cfg.robot.clearance_m, cfg.tool.clearance_m)  # as the primitive rows
     t0 = time.process_time()
     _ = arm.collision
     build_s = time.process_time() - t0
@@ -77,8 +78,9 @@ def _mesh_rows(args: argparse.Namespace, rng: np.random.Generator) -> list[tuple
     )
     free = qs[~np.array(verdict)]
     poses = np.array([arm.fk(q) for q in rng.uniform(arm.lower, arm.upper, (args.n, 6))])
-    print(f"\nmesh arm: {source}; {n_tris} triangles; broad phase agrees with every pair "
-          f"on {agree}/{len(qs)}; {len(free)} free")  # fmt: skip
+    print(f"\nmesh arm: {source}; {n_tris} triangles; clearance arm "
+          f"{cfg.robot.clearance_m * 1e3:g} mm, tool {cfg.tool.clearance_m * 1e3:g} mm; broad "
+          f"phase agrees with every pair on {agree}/{len(qs)}; {len(free)} free")  # fmt: skip
     tmp.cleanup()
     return [
         ("arm load (URDF, meshes, OPW check), CPU", min(loads), 1e6),

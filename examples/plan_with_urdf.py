@@ -3,9 +3,10 @@
 The script writes a copy of the built-in cell whose ``robot.model`` is the URDF you give
 (``robot.package_paths`` for its ``package://`` meshes), picks a home configuration for that
 arm (the IK solution of the built-in home's TCP pose nearest to zero that is free of
-collision), plans the tour with ``holecell plan``'s planner and checks every trajectory sample
-against the arm's own collision meshes. Nothing of the arm is committed to this repository;
-fetch a ROS-Industrial description and expand its xacro first, e.g.::
+collision with the cell's clearances), plans the tour with ``holecell plan``'s planner and
+checks every trajectory sample against the arm's own collision meshes (clearances kept).
+Nothing of the arm is committed to this repository; fetch a ROS-Industrial description and
+expand its xacro first, e.g.::
 
     git clone https://github.com/ros-industrial/kuka_experimental
     pip install xacro       # in a scratch venv; $(find pkg) needs ROS or a package path
@@ -58,6 +59,7 @@ def write_cell(urdf: Path, package_paths: list[Path], out: Path, base_xyz: list[
     probe = Arm(urdf, T_cell_base=T_cell_base, package_paths=package_paths)
     probe.set_tool(builtin.T_tool0_tcp(), builtin.tool_shapes())
     probe.add_obstacles(builtin.obstacle_shapes())
+    probe.set_clearance(builtin.robot.clearance_m, builtin.tool.clearance_m)  # as the cell's
     home = _home_for(probe, T_home_tcp)
     if home is None:
         raise SystemExit(f"{urdf}: no collision-free IK solution for the built-in home pose")
@@ -97,7 +99,11 @@ def main() -> int:
           f"cycle {tour.cycle_time_s:.2f} s")  # fmt: skip
     for h in tour.left_out:
         print(f"  left out {h.hole_id}: {h.reason}")
-    print(f"check      {len(traj)} samples against the URDF's collision meshes: {hits} in contact")
+    margins = f"arm {cell.robot.clearance_m * 1e3:g} mm, tool {cell.tool.clearance_m * 1e3:g} mm"
+    print(
+        f"check      {len(traj)} samples against the URDF's collision meshes: {hits} closer "
+        f"than the clearances ({margins})"
+    )
     print(f"written    {cell_path} and {args.out / 'tour.json'}")
     return 0 if not tour.left_out and hits == 0 else 1
 

@@ -37,6 +37,9 @@ def _pool(arm: object, threads: int) -> object | None:
             req.enable_contact = True
             req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
             req.security_margin = margin
+        for k, active in enumerate(collision.geom_data.activeCollisionPairs):
+            if not active:  # the hull pre-test's pairs (robots.collision_hulls)
+                gd.deactivateCollisionPair(k)
     return pool
 
 

@@ -34,6 +34,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from robots.collision_hulls import add_hull_pairs
 from robots.models import LINK_NAMES
 from robots.shapes import Shape
 
@@ -167,30 +168,65 @@ class CollisionModel:
         self.excluded_pairs = sorted(touching)
         for k in reversed(drop):
             self.geom_model.removeCollisionPair(self.geom_model.collisionPairs[k])
-        self.geom_data = pin.GeometryData(self.geom_model)
-        self._configure_requests()
+        bodies = [info.body for info in self.infos]
+        # the two links before the tool's link_6 (chain order as in _candidate_pairs)
+        wrist = {f.name for f in self.model.frames if f.parentJoint in (4, 5)}
+        self.mesh_pairs, self.hull_pairs = add_hull_pairs(self.geom_model, bodies, wrist)
+        objects = self.geom_model.geometryObjects
+        self.infos += [
+            GeomInfo(objects[i].name, bodies[i]) for i in range(len(self.infos), len(bodies))
+        ]
+        self.geom_data = self._data_without(self.hull_pairs)
         self.broadphase = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(
             self.model, self.geom_model, self.geom_data
         )
+        self._fast_broadphase = None
+        if self.hull_pairs:
+            self._fast_data = self._data_without(self.mesh_pairs)
+            self._fast_broadphase = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(
+                self.model, self.geom_model, self._fast_data
+            )
 
-    def _configure_requests(self) -> None:
+    def _data_without(self, inactive: list[int]) -> pin.GeometryData:
+        """Geometry data with its requests configured and the pairs ``inactive`` switched off."""
+        geom_data = pin.GeometryData(self.geom_model)
+        self._configure_requests(geom_data)
+        for k in inactive:
+            geom_data.deactivateCollisionPair(k)
+        return geom_data
+
+    def _configure_requests(self, geom_data: pin.GeometryData) -> None:
         # coal 3.0 misses overlapping cylinders when contacts are off (GJK stops early):
         # ask for the contact (EPA runs only on overlap) and start from the default guess.
         for pair, req in zip(
-            self.geom_model.collisionPairs, self.geom_data.collisionRequests, strict=True
+            self.geom_model.collisionPairs, geom_data.collisionRequests, strict=True
         ):
             req.enable_contact = True
             req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
             a, b = self.infos[pair.first].body, self.infos[pair.second].body
             req.security_margin = self.clearance_margins.margin(a, b)
-        for req in self.geom_data.distanceRequests:
+        for req in geom_data.distanceRequests:
             req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
 
     def in_collision(self, q: Array) -> bool:
         """True when any checked pair comes closer than its margin at ``q`` (rad).
 
-        Uses coal's dynamic AABB tree to cull pairs, then exact primitive tests.
+        Uses coal's dynamic AABB tree to cull pairs, then exact primitive tests. With arm
+        meshes, a first pass tests the tool against the links' convex hulls; "free" there is
+        final, anything else is decided by the exact pairs (:mod:`robots.collision_hulls`).
         """
+        if self._fast_broadphase is None:
+            return bool(pin.computeCollisions(self.model, self.data, self.broadphase, q, True))
+        if not pin.computeCollisions(self.model, self.data, self._fast_broadphase, q, True):
+            return False
+        # the pass stopped at its first contact: a real pair unless it was a hull pair (a hull
+        # pair's result is True only when it was hit in this pass: reset after each hit)
+        results = self._fast_data.collisionResults
+        hulls_hit = [k for k in self.hull_pairs if results[k].isCollision()]
+        for k in hulls_hit:
+            results[k].clear()
+        if not hulls_hit:
+            return True
         return bool(pin.computeCollisions(self.model, self.data, self.broadphase, q, True))
 
     def in_collision_exhaustive(self, q: Array) -> bool:
@@ -218,6 +254,7 @@ class CollisionModel:
         """
         pin.computeDistances(self.model, self.data, self.geom_model, self.geom_data, q)
         distances = np.array([r.min_distance for r in self.geom_data.distanceResults])
+        distances[self.hull_pairs] = np.inf  # the pre-test's pairs are not checked pairs
         k = int(np.argmin(distances))
         pair = self.geom_model.collisionPairs[k]
         names = self.geom_model.geometryObjects

@@ -7,6 +7,7 @@ a hollow part keeps its holes and openings, which is what an inspection tool rea
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from numpy.typing import NDArray
 
 from robots.errors import RobotModelError
 
+#: mesh files read for mesh obstacles (trimesh); URDF link meshes also take .dae (assimp)
 MESH_SUFFIXES = (".stl", ".obj", ".ply")
 
 
@@ -49,15 +51,31 @@ class TriangleMesh:
         return float(np.max(np.linalg.norm(self.vertices, axis=1)))
 
 
+def mesh_file_problem(path: Path, suffixes: tuple[str, ...] = MESH_SUFFIXES) -> str:
+    """Why ``path`` cannot be a mesh file of one of ``suffixes`` ("" when it may be): the file
+    checks shared by mesh obstacles (:func:`load_mesh`) and URDF link meshes
+    (:mod:`robots.urdf_load`), which Pinocchio then reads."""
+    if path.suffix.lower() not in suffixes:
+        return f"not a mesh file (one of {', '.join(suffixes)})"
+    if not path.exists():
+        return "no such file"
+    if not path.is_file():
+        return "is not a file"
+    if not os.access(path, os.R_OK):
+        return "cannot be read (permission denied)"
+    if path.stat().st_size == 0:
+        return "is empty"
+    return ""
+
+
 def load_mesh(path: str | Path, scale: float = 1.0) -> TriangleMesh:
     """Read an STL, OBJ or PLY file; vertices multiplied by ``scale`` (file units to m)."""
     import trimesh  # imported here: only cells with mesh obstacles pay its import time
 
     p = Path(path)
-    if p.suffix.lower() not in MESH_SUFFIXES:
-        raise MeshFileError(str(p), f"not a mesh file (one of {', '.join(MESH_SUFFIXES)})")
-    if not p.is_file():
-        raise MeshFileError(str(p), "no such file")
+    problem = mesh_file_problem(p)
+    if problem:
+        raise MeshFileError(str(p), problem)
     if not (np.isfinite(scale) and scale > 0):
         raise MeshFileError(str(p), f"scale must be a positive number, got {scale!r}")
     try:

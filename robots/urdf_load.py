@@ -22,12 +22,14 @@ import numpy as np
 import pinocchio as pin
 
 from robots.errors import MeshError, UrdfError
+from robots.meshes import MESH_SUFFIXES as OBSTACLE_MESH_SUFFIXES
+from robots.meshes import mesh_file_problem
 from robots.opw import JointLine
 
 Array = np.ndarray
 
 #: mesh file kinds coal's loader (assimp) reads for collision
-MESH_SUFFIXES = (".stl", ".obj", ".dae", ".ply")
+MESH_SUFFIXES = (*OBSTACLE_MESH_SUFFIXES, ".dae")
 
 
 @dataclass(frozen=True)
@@ -76,15 +78,7 @@ def resolve_mesh(uri: str, urdf_dir: Path, dirs: Sequence[Path]) -> tuple[Path |
 
 
 def _check_mesh(path: Path) -> str:
-    if not path.is_file():
-        return "is not a file"
-    if path.suffix.lower() not in MESH_SUFFIXES:
-        return f"is not a mesh holecell reads ({', '.join(MESH_SUFFIXES)})"
-    if not os.access(path, os.R_OK):
-        return "cannot be read (permission denied)"
-    if path.stat().st_size == 0:
-        return "is empty"
-    return ""
+    return mesh_file_problem(path, MESH_SUFFIXES)
 
 
 def collision_xml(path: Path, package_paths: Sequence[str | Path] = ()) -> tuple[str, dict]:
