@@ -6,9 +6,11 @@ The compensated pose ``T_cell_tcp(q, T; theta)`` depends on the identified terms
 differences of +-1 sigma per term (GUM's law of propagation).
 
 When the model offers its own prediction covariance (``ThermalModel.predict_covariance``, from
-the terms' full covariance kept with the model), that is used. Otherwise (a model without it) the
-terms' standard deviations (``ThermalModel.std``) are propagated here with the terms taken as
-independent. :func:`thermal_point_covariance` is the one function that decides.
+the terms' full covariance kept with the model), that is used, plus the noise of the temperature
+readings the prediction rests on (the stop's and the cold reference's, estimated by the
+identification: :func:`robots.thermal.uncertainty.reading_covariance`). Otherwise (a model
+without it) the terms' standard deviations (``ThermalModel.std``) are propagated here with the
+terms taken as independent. :func:`thermal_point_covariance` is the one function that decides.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import numpy as np
 
 from robots.thermal.compensate import compensated_T_cell_tcp
 from robots.thermal.model import ThermalModel
+from robots.thermal.uncertainty import reading_covariance
 
 
 def _with_coefficients(model: ThermalModel, coefficients: dict[str, float]) -> ThermalModel:
@@ -41,7 +44,9 @@ def thermal_point_covariance(
         return np.zeros((3, 3))
     predict = getattr(model, "predict_covariance", None)
     if predict is not None:
-        return np.asarray(predict(q_rad, temps_c, np.asarray(p_tcp_m, float), T_cell_base), float)
+        p = np.asarray(p_tcp_m, float)
+        terms = np.asarray(predict(q_rad, temps_c, p, T_cell_base), float)
+        return terms + reading_covariance(model, q_rad, temps_c, p, T_cell_base)
     if not model.std:
         return np.zeros((3, 3))
     p = np.append(np.asarray(p_tcp_m, float), 1.0)
@@ -68,5 +73,9 @@ def thermal_note(model: ThermalModel | None) -> str:
     if model is None:
         return "no thermal model: nominal kinematics, their drift is not covered"
     if getattr(model, "predict_covariance", None) is not None:
-        return "the thermal model's prediction covariance (identified terms' full covariance)"
+        u = float(model.fit.get("reading_noise_K", 0.0))
+        return (
+            "the thermal model's prediction covariance (identified terms' full covariance)"
+            f" and the readings' noise ({u:.3f} K per reading, stop and cold reference)"
+        )
     return "identified terms' standard deviations (correlations not stored: taken as independent)"

@@ -16,6 +16,11 @@ correlated in time (lag-1 correlation ``rho`` above the white-noise level ``2 / 
 then the model's structure misses something (a link lagging its sensor, say), the rows are not
 independent measurements, and the plain covariance would be too optimistic.
 
+The noise of one sensor reading (``fit["reading_noise_K"]``, :func:`reading_noise_K`) is kept
+too: a prediction at a stop rests on that stop's readings and on the cold reference readings,
+whose noise the terms' covariance does not contain
+(:func:`robots.thermal.uncertainty.reading_covariance`).
+
 Units: terms ``k_link*`` in 1/K, ``c_joint*`` in rad/K; internally scaled by
 1e-6 (ppm/K, urad/K) so the solver works on numbers near one.
 """
@@ -179,6 +184,23 @@ def serial_correlation(residual: Array, groups: Array, time_s: Array) -> tuple[f
     return (num / den if den > 0 else 0.0), pairs
 
 
+def reading_noise_K(time_s: Array, temps_degC: Array, degree: int = 4) -> float:
+    """Standard deviation (K) of one sensor reading, pooled over the sensors: the residual of a
+    smooth warm-up curve (polynomial of ``degree`` in time, per sensor) through the readings of
+    every observation; 0.0 with too few observations (fewer than ``3 * (degree + 1)``) or no
+    spread in time. A first-order warm-up over the reference rounds leaves a quartic within a
+    few mK, so the figure is the readings' noise (slightly high if the curve is not smooth)."""
+    t = np.asarray(time_s, float)
+    temps = np.asarray(temps_degC, float).reshape(len(t), -1)
+    n = len(t)
+    if n < 3 * (degree + 1) or np.ptp(t) <= 0.0:
+        return 0.0
+    V = np.vander((t - t.mean()) / np.ptp(t), degree + 1)
+    coef, *_ = np.linalg.lstsq(V, temps, rcond=None)
+    r = temps - V @ coef
+    return float(np.sqrt(np.sum(r**2) / (temps.shape[1] * (n - degree - 1))))
+
+
 def inflation_factor(rho: float, pairs: int) -> float:
     """The covariance factor for serially correlated residuals: ``(1 + rho) / (1 - rho)`` (the
     AR(1) variance factor; ``rho`` capped at 0.95) when ``rho`` exceeds ``2 / sqrt(pairs)``
@@ -330,6 +352,7 @@ def identify(
             "residual_rms_before_m": float(np.sqrt(np.mean(r0**2))),
             "sigma_m": sigma,
             "residual_lag1_correlation": rho,
+            "reading_noise_K": reading_noise_K(obs.time_s, obs.temps_degC),
             "covariance_inflation": inflation,
             "rank": float(report.rank),
             "condition": report.condition_kept,

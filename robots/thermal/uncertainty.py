@@ -102,3 +102,35 @@ def prediction_covariance(
     T_cb = np.asarray(model.T_cell_base if T_cell_base is None else T_cell_base, float)
     R = T_cb[:3, :3]
     return R @ C_base @ R.T
+
+
+def reading_covariance(
+    model: ThermalModel,
+    q: ArrayLike,
+    temps_degC: ArrayLike,
+    point_tcp_m: ArrayLike | None = None,
+    T_cell_base: ArrayLike | None = None,
+    u_reading_K: float | None = None,
+) -> Array:
+    """Covariance (3, 3) in m^2, cell frame, of the compensated position of a TCP-fixed point
+    from the noise of the temperature readings: the prediction uses the stop's readings and the
+    cold reference readings (one draw each, independent), so the variance is
+    ``2 u^2 H H^T`` with ``H = d p / d T_sensor`` (m/K, exact: the model is linear in the
+    readings). ``u_reading_K`` defaults to the identification's estimate
+    ``model.fit["reading_noise_K"]`` (0 when the model has none: a zero matrix)."""
+    u = float(model.fit.get("reading_noise_K", 0.0) if u_reading_K is None else u_reading_K)
+    if not u > 0.0:
+        return np.zeros((3, 3))
+    p_h = np.append(np.zeros(3) if point_tcp_m is None else np.asarray(point_tcp_m, float), 1.0)
+    temps = np.asarray(temps_degC, float)
+    T_tt = np.asarray(model.T_tool0_tcp, float)
+    cols = []
+    for j in range(temps.shape[-1]):
+        step = np.zeros_like(temps)
+        step[j] = 0.5
+        hi = (model.fk(q, temps + step) @ T_tt @ p_h)[:3]
+        lo = (model.fk(q, temps - step) @ T_tt @ p_h)[:3]
+        cols.append(hi - lo)  # per K (1 K step)
+    H = np.column_stack(cols)
+    R = np.asarray(model.T_cell_base if T_cell_base is None else T_cell_base, float)[:3, :3]
+    return R @ (2.0 * u * u * H @ H.T) @ R.T
