@@ -151,8 +151,10 @@ def plan_demo(
     cell: CellConfig, seed: int, plan_progress: Callable[[str, int, int], None] | None = None
 ) -> tuple[Tour, Tour]:
     """The hole tour and the reference tour of ``cell``; the reference tour is planned in a
-    second process while this one plans the holes."""
-    ctx = multiprocessing.get_context("fork")
+    second process while this one plans the holes. The second process is started by a fork
+    server, not forked from this one: a process that has run a simulator or a planner holds
+    threads (and their locks) that a forked child would inherit locked."""
+    ctx = multiprocessing.get_context("forkserver")
     with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
         ref_job = pool.submit(_plan_reference, seed)
         tour = TourPlanner(Options(seed=seed), plan_progress).plan(cell)
