@@ -100,12 +100,28 @@ class BatchEdgeChecker:
         todo = np.flatnonzero(inside)
         if not len(todo):
             return out
-        self.checks += int(sum(len(trajs[i]) for i in todo))
+        # the motions share their ends (each node is the end of many): every distinct end
+        # configuration is checked once, each motion's interior samples in its own trajectory
+        ends, which = np.unique(np.vstack([A[todo], B[todo]]), axis=0, return_inverse=True)
+        which = which.reshape(2, len(todo))
+        inner = [trajs[i][:-2] for i in todo]  # the ends are the last two rows
+        self.checks += len(ends) + int(sum(len(Q) for Q in inner))
+        end_free = ~self._hits([e[None, :] for e in ends])
+        inner_free = ~self._hits(inner)
+        out[todo] = end_free[which[0]] & end_free[which[1]] & inner_free
+        return out
+
+    def _hits(self, trajs: list[NDArray[np.float64]]) -> NDArray[np.bool_]:
+        """For each trajectory (rows: configurations): True when one of them collides."""
+        hit = np.zeros(len(trajs), dtype=bool)
+        some = [i for i, Q in enumerate(trajs) if len(Q)]
+        if not some:
+            return hit
         if self.pool is None:
             arm = self.checker.arm
-            out[todo] = [not any(arm.in_collision(q) for q in trajs[i]) for i in todo]
-            return out
-        batch: Sequence[NDArray] = [np.asfortranarray(trajs[i].T) for i in todo]
-        hits = pin.computeCollisionsInParallel(self.threads, self.pool, list(batch), True)
-        out[todo] = [not np.asarray(h).any() for h in hits]
-        return out
+            hit[some] = [any(arm.in_collision(q) for q in trajs[i]) for i in some]
+            return hit
+        batch: Sequence[NDArray] = [np.asfortranarray(trajs[i].T) for i in some]
+        res = pin.computeCollisionsInParallel(self.threads, self.pool, list(batch), True)
+        hit[some] = [np.asarray(h).any() for h in res]
+        return hit
