@@ -48,3 +48,22 @@ def test_bad_cell_file_gives_a_message_not_a_traceback(
     assert code == 2
     assert "bad.yaml: robot.home" in err
     assert "Traceback" not in err
+
+
+def test_output_into_a_closed_pipe_is_no_traceback() -> None:
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    exe = shutil.which("holecell") or str(Path(sys.executable).with_name("holecell"))
+    proc = subprocess.run(
+        f"'{exe}' cell show | head -c 1 >/dev/null; exit ${{PIPESTATUS[0]}}",
+        shell=True,
+        executable="/bin/bash",
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert "Traceback" not in proc.stderr, proc.stderr
+    assert proc.returncode in (0, 1, 141)
