@@ -390,6 +390,18 @@ def _part_temperature_problems(cfg: CellConfig) -> list[tuple[str, object, str]]
     return []
 
 
+def _path_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
+    """Files and folders the cell names that are not there (resolved against the cell file)."""
+    problems: list[tuple[str, object, str]] = []
+    calibration = cfg.calibration_path()
+    if calibration is not None and not calibration.is_file():
+        problems.append(("tool.calibration", str(calibration), "no such file"))
+    for i, folder in enumerate(cfg.package_paths()):
+        if not folder.is_dir():
+            problems.append((f"robot.package_paths[{i}]", str(folder), "no such folder"))
+    return problems
+
+
 def _mesh_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
     problems = []
     for group, shapes in (
@@ -474,7 +486,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
     if cfg.part.holes_csv is not None:
         cfg = _with_csv_holes(cfg, source, source_path, text)
     problems = (
-        _duplicate_ids(cfg) + _part_temperature_problems(cfg)
+        _duplicate_ids(cfg) + _part_temperature_problems(cfg) + _path_problems(cfg)
         or _mesh_problems(cfg)
         or _robot_problems(cfg)
     )

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from cell.commands.run_progress import bar
+from cell.errors import CellError
 from measure import MeasureOptions, StereoCalibration, measure_hole
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm")
@@ -245,6 +246,8 @@ def _progress(stream):
 def run_batch(args: argparse.Namespace) -> int:
     """Handler of ``holecell measure --pairs``: 0 all measured, 1 some pairs failed."""
     t0 = time.perf_counter()
+    if args.output and Path(args.output).suffix.lower() not in (".csv", ".json"):
+        raise CellError(f"-o {args.output}: the rows file must end in .csv or .json")
     opts = MeasureOptions.published() if args.method == "published" else MeasureOptions()
     stereo = StereoCalibration.load(args.stereo)
     entries = collect_pairs(args.pairs)

@@ -164,3 +164,23 @@ def test_directory_and_binary_files_are_refused(tmp_path: Path) -> None:
     binary.write_bytes(b"name: \xff\xfe\x00bad")
     with pytest.raises(ConfigError, match="UTF-8"):
         load_cell(binary)
+
+
+def test_missing_calibration_file_and_package_folder_are_named(tmp_path) -> None:
+    from cell.config import DATA_DIR, load_cell
+    from cell.errors import ConfigError
+
+    text = (DATA_DIR / "motorcycle_frame.yaml").read_text()
+    text = text.replace("tool:\n", "tool:\n  calibration: head/stereo.json\n", 1)
+    text = text.replace("robot:\n", "robot:\n  package_paths: [ros_ws/src]\n", 1)
+    path = tmp_path / "cell.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        load_cell(path)
+    msg = str(err.value)
+    assert "tool.calibration" in msg and "head/stereo.json" in msg and "no such file" in msg
+    assert "robot.package_paths[0]" in msg and "no such folder" in msg
+    (tmp_path / "head").mkdir()
+    (tmp_path / "head" / "stereo.json").write_text("{}")
+    (tmp_path / "ros_ws" / "src").mkdir(parents=True)
+    assert load_cell(path).calibration_path() == tmp_path / "head" / "stereo.json"

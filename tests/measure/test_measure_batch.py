@@ -99,3 +99,13 @@ def test_pairing_rules(tmp_path, capsys):
     st = _stereo(tmp_path)
     assert main(["measure", "--pairs", str(tmp_path / "none"), "--stereo", st]) == 2
     assert "no such folder or list file" in capsys.readouterr().err
+
+
+def test_rows_file_of_another_kind_is_refused_before_measuring(tmp_path, capsys):
+    d = tmp_path / "pairs"
+    d.mkdir()
+    args = ["measure", "--pairs", str(d), "--stereo", _stereo(tmp_path)]
+    assert main([*args, "-o", str(tmp_path / "rows.txt")]) == 2
+    err = capsys.readouterr().err
+    assert "rows.txt" in err and ".csv or .json" in err
+    assert not (tmp_path / "rows.txt").exists()
