@@ -235,17 +235,20 @@ class Runner(Motion):
 
     # --- reference targets -----------------------------------------------------------------
     def _home_for_reference(self) -> None:
-        """Bring the arm home along the inspection tour if it is elsewhere (a resumed run stopped
-        at a hole or between holes): the reference trajectory starts at home, and a controller
-        refuses to load a trajectory the arm is not on."""
+        """Bring the arm home if it is elsewhere (a resumed run stopped at a hole, between holes
+        or on the way to a reference target): the reference trajectory starts at home, and a
+        controller refuses to load a trajectory the arm is not on, so the arm goes home along
+        whichever of the two tours it stands on."""
         home = np.asarray(self.reference_tour.trajectory[0], float)
         st = self._call("status", self.client.status)
         if np.max(np.abs(st.q_rad - home)) <= HOME_TOL_RAD:
             return
-        self.store.event("motion", "the arm is off home: homing along the tour before the "
-                                   "reference targets")  # fmt: skip
-        self._load(self.tour)
-        self._move(len(self.tour.stops), "home before the reference targets")
+        tours = {"inspection": self.tour, "reference": self.reference_tour}
+        name = min(tours, key=lambda n: _distance_to_path_rad(tours[n], st.q_rad))
+        self.store.event("motion", f"the arm is off home: homing along the {name} tour before "
+                                   "the reference targets")  # fmt: skip
+        self._load(tours[name])
+        self._move(len(tours[name].stops), "home before the reference targets")
 
     def _reference_phase(self) -> None:
         tour = self.reference_tour
@@ -335,3 +338,9 @@ class _Laps:
     def lap(self, name: str) -> None:
         t = time.perf_counter()
         self.laps[name], self._t = t - self._t, t
+
+
+def _distance_to_path_rad(tour: Tour, q_rad: np.ndarray) -> float:
+    """Largest joint difference (rad) between ``q_rad`` and the nearest sample of the tour."""
+    rows = np.asarray(tour.trajectory, float)
+    return float(np.min(np.max(np.abs(rows - q_rad), axis=1)))

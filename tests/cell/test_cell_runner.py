@@ -103,6 +103,21 @@ def test_estop_stops_the_run_and_resume_completes(small_cell: SmallCell, tmp_pat
     assert [r.hole_id for r in stored] == small_cell.tour.hole_order
 
 
+def test_estop_during_the_reference_rounds_resumes(small_cell: SmallCell, tmp_path: Path) -> None:
+    # the arm stops on the reference trajectory: the resumed run goes home along that one
+    faults = FaultPlan(estop_at_stop=1)
+    with SimCell.start(small_cell.cell, WorldOptions(speed=20.0), faults) as sim:
+        with pytest.raises(RunFaultError, match="reference"):
+            _run(small_cell, tmp_path, sim, rounds=2)
+        with ControllerClient(sim.url, FAST_LINK) as operator:
+            operator.reset()
+        sim.controller.estop_at_stop = None
+        result, stored, events = _run(small_cell, tmp_path, sim, resume=True, rounds=2)
+    assert result.status == "done"
+    assert [r.hole_id for r in stored] == small_cell.tour.hole_order
+    assert any("along the reference tour" in e.get("message", "") for e in events)
+
+
 def test_tour_for_another_cell_is_refused(small_cell: SmallCell, tmp_path: Path) -> None:
     other = small_cell.cell.model_copy(update={"name": "other_frame"})
     with pytest.raises(TourMismatchError, match="other_frame"):
