@@ -18,6 +18,7 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator
 
+from cell.config_checks import cell_problems
 from cell.config_mesh import MeshSpec
 from cell.errors import ConfigError
 from cell.holes_csv import read_holes_csv
@@ -28,8 +29,7 @@ from cell.uncertainty.materials import (
     MaterialSpec,
     material_field,
 )
-from robots import DEFAULT_MODEL, Arm, LimitScaling, LimitsError, RobotModelError, Shape
-from robots.meshes import MeshFileError
+from robots import DEFAULT_MODEL, Arm, LimitScaling, Shape
 from robots.transforms import pose_to_matrix
 
 DATA_DIR = Path(__file__).parent / "data"
@@ -369,82 +369,6 @@ def _pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
     return problems
 
 
-def _duplicate_ids(cfg: CellConfig) -> list[tuple[str, object, str]]:
-    problems = []
-    for group, items in (
-        ("part.holes", cfg.part.holes),
-        ("reference_targets", cfg.reference_targets),
-    ):
-        seen: set[str] = set()
-        for i, item in enumerate(items):
-            if item.id in seen:
-                problems.append((f"{group}[{i}].id", item.id, "duplicate id"))
-            seen.add(item.id)
-    return problems
-
-
-def _part_temperature_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
-    if cfg.part.u_temperature_K is not None and cfg.part.temperature_c is None:
-        msg = "needs part.temperature_c (the temperature it is the uncertainty of)"
-        return [("part.u_temperature_K", cfg.part.u_temperature_K, msg)]
-    return []
-
-
-def _path_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
-    """Files and folders the cell names that are not there (resolved against the cell file)."""
-    problems: list[tuple[str, object, str]] = []
-    calibration = cfg.calibration_path()
-    if calibration is not None and not calibration.is_file():
-        problems.append(("tool.calibration", str(calibration), "no such file"))
-    for i, folder in enumerate(cfg.package_paths()):
-        if not folder.is_dir():
-            problems.append((f"robot.package_paths[{i}]", str(folder), "no such folder"))
-    return problems
-
-
-def _mesh_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
-    problems = []
-    for group, shapes in (
-        ("tool.shapes", cfg.tool.shapes),
-        ("part.obstacles", cfg.part.obstacles),
-        ("environment.obstacles", cfg.environment.obstacles),
-    ):
-        for i, spec in enumerate(shapes):
-            if spec.mesh is None:
-                continue
-            path = spec.mesh.resolved(cfg.base_dir)
-            try:
-                spec.mesh.load(cfg.base_dir)
-            except MeshFileError as exc:
-                problems.append((f"{group}[{i}].mesh.path", str(path), exc.reason))
-    return problems
-
-
-def _robot_problems(cfg: CellConfig) -> list[tuple[str, object, str]]:
-    try:
-        arm = cfg.build_arm()
-    except LimitsError as exc:
-        return [("robot.limits.position", cfg.robot.limits.position, str(exc))]
-    except RobotModelError as exc:
-        return [("robot.model", cfg.robot.model, str(exc))]
-    q = cfg.home_q()
-    if not np.all(np.isfinite(q)):
-        return [("robot.home", cfg.robot.home, "joint values must be finite numbers (rad)")]
-    if not arm.within_limits(q):
-        bad = [arm.joint_names[i] for i in range(6) if not arm.lower[i] <= q[i] <= arm.upper[i]]
-        return [
-            (
-                "robot.home",
-                cfg.robot.home,
-                f"outside the joint limits of {arm.name} ({', '.join(bad)})",
-            )
-        ]
-    if arm.in_collision(q):
-        pairs = ", ".join(f"{a} / {b}" for a, b in arm.colliding_pairs(q)[:3])
-        return [("robot.home", cfg.robot.home, f"in collision ({pairs})")]
-    return []
-
-
 def _with_csv_holes(
     cfg: CellConfig, source: str, source_path: Path | None, text: str
 ) -> CellConfig:
@@ -485,11 +409,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
     cfg._raw_text = text
     if cfg.part.holes_csv is not None:
         cfg = _with_csv_holes(cfg, source, source_path, text)
-    problems = (
-        _duplicate_ids(cfg) + _part_temperature_problems(cfg) + _path_problems(cfg)
-        or _mesh_problems(cfg)
-        or _robot_problems(cfg)
-    )
+    problems = cell_problems(cfg)
     if problems:
         raise ConfigError(source, problems)
     return cfg
