@@ -66,10 +66,10 @@ def _found(img: np.ndarray, size: tuple[int, int]) -> dict[str, bool]:
     }
 
 
-def _opencv_sample(pairs, size: tuple[int, int], pitch: float):
-    """OpenCV's samples/cpp/stereo_calib.cpp: classic detector, cornerSubPix 11×11, one
-    stereoCalibrate with the sample's flags (same focal length, rational model k4–k6 fixed)."""
-    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01)
+def _classic_corners(pairs, size: tuple[int, int], pitch: float, eps: float):
+    """Board points and left/right corners of every pair both cameras see, as OpenCV's samples
+    find them: classic detector (no fast check), cornerSubPix 11×11 to ``eps`` px."""
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, eps)
     obj1 = np.zeros((size[0] * size[1], 3), np.float32)
     obj1[:, :2] = np.mgrid[0 : size[0], 0 : size[1]].T.reshape(-1, 2) * pitch
     L, R = [], []
@@ -83,6 +83,13 @@ def _opencv_sample(pairs, size: tuple[int, int], pitch: float):
             R.append(got[1])
     obj = [obj1] * len(L)
     wh = pairs[0][1].shape[::-1]
+    return obj, L, R, wh
+
+
+def _opencv_sample(pairs, size: tuple[int, int], pitch: float):
+    """OpenCV's samples/cpp/stereo_calib.cpp: classic detector, cornerSubPix 11×11, one
+    stereoCalibrate with the sample's flags (same focal length, rational model k4–k6 fixed)."""
+    obj, L, R, wh = _classic_corners(pairs, size, pitch, 0.01)
     K1 = cv2.initCameraMatrix2D(obj, L, wh, 0)
     K2 = cv2.initCameraMatrix2D(obj, R, wh, 0)
     flags = (
@@ -114,20 +121,7 @@ def _opencv_plain(pairs, size: tuple[int, int], pitch: float):
     """OpenCV's Python calibration tutorial, per camera then for the pair: classic detector
     (no fast check), cornerSubPix 11×11, ``calibrateCamera`` with its default model (k3 free),
     ``stereoCalibrate`` with its default ``CALIB_FIX_INTRINSIC``."""
-    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.001)
-    obj1 = np.zeros((size[0] * size[1], 3), np.float32)
-    obj1[:, :2] = np.mgrid[0 : size[0], 0 : size[1]].T.reshape(-1, 2) * pitch
-    L, R = [], []
-    for _, left, right in pairs:
-        got = []
-        for img in (left, right):
-            ok, c = cv2.findChessboardCorners(img, size, flags=_CLASSIC)
-            got.append(cv2.cornerSubPix(img, c, (11, 11), (-1, -1), crit) if ok else None)
-        if all(g is not None for g in got):
-            L.append(got[0])
-            R.append(got[1])
-    obj = [obj1] * len(L)
-    wh = pairs[0][1].shape[::-1]
+    obj, L, R, wh = _classic_corners(pairs, size, pitch, 0.001)
     _, K1, d1, _, _ = cv2.calibrateCamera(obj, L, wh, None, None)
     _, K2, d2, _, _ = cv2.calibrateCamera(obj, R, wh, None, None)
     rms, K1, _, K2, _, Rm, T, _, _ = cv2.stereoCalibrate(obj, L, R, K1, d1, K2, d2, wh)
