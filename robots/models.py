@@ -47,7 +47,6 @@ class ArmSpec:
         lower_rad, upper_rad: joint position limits (rad).
         max_speed_rad_s: joint speed limits (rad/s).
         reach_m: nominal reach in the model's name (m).
-        scale: size of the collision shapes relative to the IRB 2600.
     """
 
     name: str
@@ -57,7 +56,6 @@ class ArmSpec:
     upper_rad: tuple[float, ...]
     max_speed_rad_s: tuple[float, ...]
     reach_m: float
-    scale: float
 
     @property
     def d1(self) -> float:
@@ -112,7 +110,6 @@ MODELS: dict[str, ArmSpec] = {
         upper_rad=(3.142, 2.094, 1.134, 3.491, 2.007, 6.981),
         max_speed_rad_s=(3.142, 3.142, 3.491, 6.981, 6.981, 8.029),
         reach_m=1.45,
-        scale=0.85,
     ),
     "abb_irb2600_20_165": ArmSpec(
         name="abb_irb2600_20_165",
@@ -129,7 +126,6 @@ MODELS: dict[str, ArmSpec] = {
         upper_rad=(3.142, 2.705, 1.309, 6.981, 2.094, 6.981),
         max_speed_rad_s=(3.054, 3.054, 3.054, 6.283, 6.283, 8.727),
         reach_m=1.65,
-        scale=1.0,
     ),
     "abb_irb4600_60_205": ArmSpec(
         name="abb_irb4600_60_205",
@@ -146,7 +142,6 @@ MODELS: dict[str, ArmSpec] = {
         upper_rad=(3.141, 2.617, 1.308, 6.981, 2.094, 6.981),
         max_speed_rad_s=(3.054, 3.054, 3.054, 4.363, 4.363, 6.283),
         reach_m=2.05,
-        scale=1.25,
     ),
 }
 

@@ -34,6 +34,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     cell.set_defaults(handler=lambda args: (cell.print_help(), 2)[1])
 
 
+def _count(n: int, noun: str) -> str:
+    """``n`` and the noun, plural unless ``n`` is 1 (``1 obstacle``, ``3 obstacles``)."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
+
 def _summary(cfg: CellConfig) -> list[str]:
     arm = cfg.build_arm()
     base = cfg.robot.base
@@ -46,12 +51,12 @@ def _summary(cfg: CellConfig) -> list[str]:
         f"{len(cfg.tool.shapes)} shapes",
         f"clearance arm {cfg.robot.clearance_m * 1e3:g} mm, tool {cfg.tool.clearance_m * 1e3:g} mm "
         "(to obstacles; the tool's also to the arm)",
-        f"part      base xyz {cfg.part.base.xyz}, {len(cfg.part.holes)} holes"
+        f"part      base xyz {cfg.part.base.xyz}, {_count(len(cfg.part.holes), 'hole')}"
         + (f" (with {cfg.part.holes_csv})" if cfg.part.holes_csv else "")
         + ", "
-        f"{len(cfg.part.obstacles)} obstacles",
-        f"cell      {len(cfg.environment.obstacles)} environment obstacles, "
-        f"{len(cfg.reference_targets)} reference targets",
+        f"{_count(len(cfg.part.obstacles), 'obstacle')}",
+        f"cell      {_count(len(cfg.environment.obstacles), 'environment obstacle')}, "
+        f"{_count(len(cfg.reference_targets), 'reference target')}",
     ]
     if arm.collision.excluded_pairs:
         lines.append(

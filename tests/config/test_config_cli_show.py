@@ -36,6 +36,7 @@ part:
     out = capsys.readouterr().out
     assert code == 1
     assert "UNREACHABLE: out of reach" in out
+    assert "1 hole," in out and "0 obstacles" in out and "0 reference targets" in out
 
 
 def test_bad_cell_file_gives_a_message_not_a_traceback(
