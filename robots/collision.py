@@ -48,9 +48,9 @@ CHAIN_BODIES: tuple[str, ...] = (*LINK_NAMES, "tool")
 
 #: up to this many geometries the naive broad phase (every two boxes) beats sweep-and-prune
 #: (us per check on random configurations, the built-in cell plus copies of its obstacles,
-#: naive vs SSaP: 46-53 geometries 11-24 vs 13-29, ~120: 24-28 vs 23-41, ~220: 60 vs 38,
-#: ~420: 220 vs 70; docs/robots.md)
-NAIVE_MAX_GEOMETRIES = 100
+#: naive vs SSaP: 46-53 geometries 11-24 vs 13-29, 114-121: 24-28 vs 23-41, 216-223: 60 vs
+#: 38, 420-427: 220 vs 70; crossover near 115 (primitives) to 160 (mesh arm); docs/robots.md)
+NAIVE_MAX_GEOMETRIES = 120
 
 
 #: the broad-phase managers :func:`broad_phase` picks from
