@@ -18,8 +18,11 @@ Margins rather than inflated primitives, because a margin works the same for
 meshes (which cannot be inflated), differs per pair (tool, arm, self) on one
 shape, and keeps the q = 0 exclusion on the true shapes.
 
-Speed: coal's dynamic AABB tree (a Pinocchio broad-phase manager) culls the
-pairs whose boxes do not overlap; only the rest get the exact primitive test.
+Speed: a Pinocchio broad-phase manager culls the pairs whose boxes (grown by
+half the pair's margin) do not overlap; only the rest get the exact test. Up to
+:data:`NAIVE_MAX_GEOMETRIES` geometries coal's naive manager (every two boxes) is the
+fastest, beyond it sweep-and-prune (:func:`broad_phase`); coal's dynamic AABB tree
+spent 11 us per check in its tree traversal alone (built-in cell, ROS-I IRB 2600 meshes).
 Every request starts GJK from coal's default guess, never the previous
 result, and asks for the contact: with contacts off, coal 3.0 reports some
 overlapping cylinder pairs as free (seen on the forearm against the upper arm).
@@ -42,6 +45,32 @@ Array = NDArray[np.float64]
 
 #: bodies of the arm chain, in order; adjacent ones are never checked against each other
 CHAIN_BODIES: tuple[str, ...] = (*LINK_NAMES, "tool")
+
+#: up to this many geometries the naive broad phase (every two boxes) beats sweep-and-prune
+#: (us per check on random configurations, the built-in cell plus copies of its obstacles,
+#: naive vs SSaP: 46-53 geometries 11-24 vs 13-29, 114-121: 24-28 vs 23-41, 216-223: 60 vs
+#: 38, 420-427: 220 vs 70; crossover near 115 (primitives) to 160 (mesh arm); docs/robots.md)
+NAIVE_MAX_GEOMETRIES = 120
+
+
+#: the broad-phase managers :func:`broad_phase` picks from
+BroadPhase = (
+    pin.BroadPhaseManager_NaiveCollisionManager | pin.BroadPhaseManager_SSaPCollisionManager
+)
+
+
+def broad_phase(
+    model: pin.Model, geom_model: pin.GeometryModel, geom_data: pin.GeometryData
+) -> BroadPhase:
+    """A broad-phase manager for ``geom_data``: naive for small cells, else sweep-and-prune.
+
+    Both only cull on (margin-grown) boxes, so the answer is that of every pair; coal's
+    dynamic AABB tree is exact too but slower here, and its array variant missed collisions
+    (coal 3.0.3) and is not used.
+    """
+    if len(geom_model.geometryObjects) <= NAIVE_MAX_GEOMETRIES:
+        return pin.BroadPhaseManager_NaiveCollisionManager(model, geom_model, geom_data)
+    return pin.BroadPhaseManager_SSaPCollisionManager(model, geom_model, geom_data)
 
 
 @dataclass(frozen=True)
@@ -177,15 +206,14 @@ class CollisionModel:
             GeomInfo(objects[i].name, bodies[i]) for i in range(len(self.infos), len(bodies))
         ]
         self.geom_data = self._data_without(self.hull_pairs)
-        self.broadphase = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(
-            self.model, self.geom_model, self.geom_data
-        )
+        self.broadphase = broad_phase(self.model, self.geom_model, self.geom_data)
         self._fast_broadphase = None
         if self.hull_pairs:
             self._fast_data = self._data_without(self.mesh_pairs)
-            self._fast_broadphase = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(
-                self.model, self.geom_model, self._fast_data
-            )
+            self._fast_broadphase = broad_phase(self.model, self.geom_model, self._fast_data)
+            # stops at the first contact and keeps that pair's index
+            self._first_hit = pin.CollisionCallBackDefault(self.geom_model, self._fast_data, True)
+            self._mesh_pair_of = dict(zip(self.hull_pairs, self.mesh_pairs, strict=True))
 
     def _data_without(self, inactive: list[int]) -> pin.GeometryData:
         """Geometry data with its requests configured and the pairs ``inactive`` switched off."""
@@ -211,21 +239,21 @@ class CollisionModel:
     def in_collision(self, q: Array) -> bool:
         """True when any checked pair comes closer than its margin at ``q`` (rad).
 
-        Uses coal's dynamic AABB tree to cull pairs, then exact primitive tests. With arm
-        meshes, a first pass tests the tool against the links' convex hulls; "free" there is
-        final, anything else is decided by the exact pairs (:mod:`robots.collision_hulls`).
+        A broad phase culls pairs (:func:`broad_phase`), then exact tests. With arm meshes, a
+        first pass tests the tool against the links' convex hulls instead of their meshes; it
+        stops at its first contact. Free there is final; a contact of a real pair is final; a
+        contact of a hull pair is decided by that hull's mesh pair (a contact there is final),
+        and only a hull hit whose mesh is clear runs every exact pair
+        (:mod:`robots.collision_hulls`).
         """
         if self._fast_broadphase is None:
             return bool(pin.computeCollisions(self.model, self.data, self.broadphase, q, True))
-        if not pin.computeCollisions(self.model, self.data, self._fast_broadphase, q, True):
+        hit = self._first_hit
+        if not pin.computeCollisions(self.model, self.data, self._fast_broadphase, hit, q):
             return False
-        # the pass stopped at its first contact: a real pair unless it was a hull pair (a hull
-        # pair's result is True only when it was hit in this pass: reset after each hit)
-        results = self._fast_data.collisionResults
-        hulls_hit = [k for k in self.hull_pairs if results[k].isCollision()]
-        for k in hulls_hit:
-            results[k].clear()
-        if not hulls_hit:
+        mesh_pair = self._mesh_pair_of.get(hit.collisionPairIndex)
+        # the fast pass placed every geometry at q; the mesh pair's request keeps its margin
+        if mesh_pair is None or pin.computeCollision(self.geom_model, self._fast_data, mesh_pair):
             return True
         return bool(pin.computeCollisions(self.model, self.data, self.broadphase, q, True))
 

@@ -7,8 +7,8 @@ lies inside its convex hull, so a tool shape farther than the margin from the hu
 from the mesh: :func:`add_hull_pairs` adds each such link's hull (coal, qhull) as a geometry of
 the same link, paired with the tool shapes (wrist links only: the broad phase culls the
 others), for a fast pass in place of the tool-vs-mesh pairs: its "free" is final, a contact of a
-real pair is final, and a contact of a hull pair sends the check to the exact pairs
-(:meth:`robots.collision.CollisionModel.in_collision`).
+real pair is final, and a contact of a hull pair is decided by that hull's mesh pair (every exact
+pair runs only when that mesh is clear: :meth:`robots.collision.CollisionModel.in_collision`).
 """
 
 from __future__ import annotations

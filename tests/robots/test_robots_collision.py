@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import robots.collision as collision_module
 from robots import Arm, Shape, ShapeError
 from robots.transforms import make_transform, pose_to_matrix
 
@@ -109,7 +110,11 @@ def test_deep_cylinder_overlap_missed_by_plain_gjk_is_caught() -> None:
     assert arm.collision.in_collision_exhaustive(Q_FREE)
 
 
-def test_collision_agrees_with_exhaustive_check_and_distance() -> None:
+@pytest.mark.parametrize("naive_max", [120, 0], ids=["naive", "sweep-and-prune"])
+def test_collision_agrees_with_exhaustive_check_and_distance(
+    naive_max: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(collision_module, "NAIVE_MAX_GEOMETRIES", naive_max)
     arm = _tool_arm()
     rng = np.random.default_rng(2)
     for i in range(30):
@@ -126,6 +131,8 @@ def test_collision_agrees_with_exhaustive_check_and_distance() -> None:
         if abs(distance) > 1e-6:
             assert hit == (distance < 0.0)
     assert 0 < n_hit < 400
+    kind = "Naive" if naive_max else "SSaP"
+    assert kind in type(arm.collision.broadphase).__name__
 
 
 def test_bad_shapes_are_refused() -> None:
