@@ -11,6 +11,10 @@ node of every hole exactly for the new order (layered shortest path). A new
 tour replaces the current one when it is not worse by more than a threshold
 that shrinks to zero; the best tour is returned.
 
+``record`` (optional): every tour the search accepts (as its current or best tour) is
+appended to it as its node list, so that a caller checking motions lazily can check the
+motions of the tours the search is heading for in one batch, not one tour at a time.
+
 Determinism: all randomness comes from ``numpy.random.default_rng(seed)``; the
 search stops after ``max_iterations`` or after ``patience`` iterations without
 a new best, whichever comes first. ``time_limit_s`` is a hard cap on the thread's CPU
@@ -79,11 +83,16 @@ class GtspLns:
     """The search over one problem instance (see module docstring)."""
 
     def __init__(
-        self, G: NDArray[np.floating], groups: Sequence[NDArray[np.int64]], seed: int
+        self,
+        G: NDArray[np.floating],
+        groups: Sequence[NDArray[np.int64]],
+        seed: int,
+        record: list[list[int]] | None = None,
     ) -> None:
         self.G = G
         self.groups = [np.asarray(g, dtype=np.int64) for g in groups]
         self.rng = np.random.default_rng(seed)
+        self.record = record
 
     def _rechoose(self, order: list[int]) -> tuple[list[int], list[int], float]:
         nodes, cost = layered_nodes(self.G, [self.groups[h] for h in order])
@@ -170,6 +179,8 @@ class GtspLns:
             threshold = settings.start_threshold * best[2] * (1 - it / settings.max_iterations)
             if new[2] < cur[2] + threshold:
                 cur = new
+                if self.record is not None:
+                    self.record.append(list(new[1]))
             if new[2] < best[2] - 1e-9:
                 best, since_best = new, 0
             else:

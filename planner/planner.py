@@ -50,6 +50,9 @@ REFINE_SHARE = 0.15
 LAZY_ROUNDS = 60
 #: ... and a safety cap in time, as a multiple of the sequencing budget
 LAZY_BUDGET_SHARE = 3.0
+#: a colliding tour motion: this many of the cheapest unknown motions between the same two
+#: holes (other candidates) are checked with it
+SIBLINGS = 8
 #: a motion OMPL could not plan costs this much (s) and the tour is re-sequenced, this many times
 UNSOLVED_COST_S = 1000.0
 MAX_UNSOLVED = 5
@@ -220,46 +223,130 @@ class TourPlanner:
         seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
 
     def _avoid_colliding_edges(
-        self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker, n_holes: int
+        self,
+        seqr: GtspSequencer,
+        res: SequenceResult,
+        checker: MotionChecker,
+        n_holes: int,
+        seen: list[list[int]],
     ) -> SequenceResult:
-        """Lazy collision checking: the tour's unchecked edges are checked in one batch at
-        the set resolution; colliding ones get their roadmap detour cost; re-sequence.
+        """Lazy collision checking until the tour's motions are known to be free.
+
+        A round checks, in one batch at the roadmap's coarse resolution (it proves
+        collisions at a sixth of the cost), the unknown motions of the tour and of every
+        tour the search accepted on its way there (``seen``); every colliding one gets its
+        roadmap detour cost, so the next search does not walk into them one at a time.
+        When the tour has no colliding motion left, its unknown motions are checked at the
+        set resolution (a collision there: another round). A round re-sequences by a short
+        repair search from the tour.
 
         Stops after ``LAZY_ROUNDS`` rounds (work, not time: the same seed gives the same
         tour); the time cap ``LAZY_BUDGET_SHARE`` × budget only binds on a crawling machine."""
         o = self.options
         started = time.thread_time()
         for k in range(LAZY_ROUNDS + 1):
-            blocked = self._blocked_on_tour(seqr, res, checker)
+            on_tour = self._blocked_on_tours(seqr, res.nodes or [], seen, checker)
             out_of_work = k == LAZY_ROUNDS
             out_of_time = time.thread_time() - started > LAZY_BUDGET_SHARE * o.budget_s(n_holes)
-            if not blocked or out_of_work or out_of_time:
+            if not on_tour or out_of_work or out_of_time:
                 break
-            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
             budget = o.budget_s(n_holes) * REFINE_SHARE
-            res = seqr.solve(budget, o.seed + 100 + k, o.effort, warm=res.nodes, repair=True)
+            seen = []
+            res = seqr.solve(budget, o.seed + 100 + k, o.effort, res.nodes, True, seen)
         self._lazy_rounds += k
         return res
 
-    def _blocked_on_tour(
-        self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker
-    ) -> list[tuple[int, int]]:
-        """Check the tour's unchecked edges (one batch, set resolution); the colliding ones
-        whose cost is not yet a detour's (in the direction travelled)."""
-        path = [0, *(res.nodes or []), 0]
-        keys = [(min(u, v), max(u, v)) for u, v in itertools.pairwise(path)]
-        todo = sorted({key for key in keys if key not in self._edge_free})
+    def _blocked_on_tours(
+        self,
+        seqr: GtspSequencer,
+        nodes: list[int],
+        seen: list[list[int]],
+        checker: MotionChecker,
+    ) -> bool:
+        """Check the unknown motions of the tour ``nodes`` and of the ``seen`` tours (see
+        :meth:`_avoid_colliding_edges`), learn the detour cost of every colliding one; True
+        when the tour itself had a colliding motion whose cost was not a detour's yet."""
+        tours = [[0, *t, 0] for t in (nodes, *seen)]
+        keys = {(min(u, v), max(u, v)) for t in tours for u, v in itertools.pairwise(t)}
+        todo = sorted(k for k in keys if k not in self._edge_free and k not in self._coarse_free)
         if todo:
-            e = np.array(todo)
-            free = self._batch.free(seqr.nodes[e[:, 0]], seqr.nodes[e[:, 1]])
-            self._edge_free.update(zip(todo, free.tolist(), strict=True))
-        checker.checks += self._batch.checks
-        self._batch.checks = 0
-        return [
-            (u, v)
-            for (u, v), key in zip(itertools.pairwise(path), keys, strict=True)
-            if not self._edge_free[key] and (u, v) not in seqr.learned
-        ]
+            free = self._free(self._coarse_batch, seqr, todo, checker)
+            for key, f in zip(todo, free.tolist(), strict=True):
+                if f:
+                    self._coarse_free.add(key)
+                else:
+                    self._edge_free[key] = False
+        path = tours[0]
+        fine = sorted({(min(u, v), max(u, v)) for u, v in itertools.pairwise(path)})
+        if not any(self._edge_free.get(key) is False for key in fine):
+            todo = [key for key in fine if key not in self._edge_free]
+            if todo:
+                free = self._free(self._batch, seqr, todo, checker)
+                self._edge_free.update(zip(todo, free.tolist(), strict=True))
+        blocked = sorted(
+            {
+                (u, v)
+                for t in tours
+                for u, v in itertools.pairwise(t)
+                if self._edge_free.get((min(u, v), max(u, v))) is False
+                and (u, v) not in seqr.learned
+            }
+        )
+        on_tour = set(itertools.pairwise(path))
+        if blocked:
+            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
+        hit = [e for e in blocked if e in on_tour]
+        if hit:
+            self._block_siblings(seqr, hit, checker)
+        return bool(hit)
+
+    def _block_siblings(
+        self, seqr: GtspSequencer, hit: list[tuple[int, int]], checker: MotionChecker
+    ) -> None:
+        """The motions between the same two holes as a colliding tour motion, by other
+        candidates, that look cheaper than its detour: checked coarse in one batch, the
+        colliding ones learned (the next search would otherwise try them one by one)."""
+        group = [np.array([0]), *seqr.groups]
+        todo: set[tuple[int, int]] = set()
+        for u, v in hit:
+            a, b = group[int(seqr.owner[u]) + 1], group[int(seqr.owner[v]) + 1]
+            C = seqr.G[np.ix_(a, b)]
+            found = 0
+            for flat in np.argsort(C, axis=None, kind="stable"):
+                i, j = divmod(int(flat), len(b))
+                if found == SIBLINGS or not C[i, j] < seqr.G[u, v]:
+                    break
+                key = (min(int(a[i]), int(b[j])), max(int(a[i]), int(b[j])))
+                if key not in self._edge_free and key not in self._coarse_free:
+                    todo.add(key)
+                    found += 1
+        if not todo:
+            return
+        keys = sorted(todo)
+        free = self._free(self._coarse_batch, seqr, keys, checker)
+        blocked = []
+        for key, f in zip(keys, free.tolist(), strict=True):
+            if f:
+                self._coarse_free.add(key)
+            else:
+                self._edge_free[key] = False
+                blocked.append(key)
+        self._siblings += len(blocked)
+        if blocked:
+            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
+
+    @staticmethod
+    def _free(
+        batch: BatchEdgeChecker,
+        seqr: GtspSequencer,
+        keys: list[tuple[int, int]],
+        checker: MotionChecker,
+    ) -> NDArray[np.bool_]:
+        e = np.array(keys)
+        free = batch.free(seqr.nodes[e[:, 0]], seqr.nodes[e[:, 1]])
+        checker.checks += batch.checks
+        batch.checks = 0
+        return free
 
     def _sequence_and_paths(
         self,
@@ -276,14 +363,18 @@ class TourPlanner:
         self._edge_free: dict[tuple[int, int], bool] = {}
         self._roadmap = Roadmap()
         self._lazy_rounds = 0
+        self._coarse_free: set[tuple[int, int]] = set()  # free at the coarse resolution
+        self._siblings = 0
         if self.sequencer is not None:
             res = self.sequencer(home, cands, limits)
             seqr = None
         else:
             seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
             self._build_roadmap(seqr, cache.checker)
-            res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort)
-            res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
+            self._coarse_batch = BatchEdgeChecker(cache.checker.coarser(ROADMAP_COARSENESS))
+            seen: list[list[int]] = []
+            res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort, record=seen)
+            res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands), seen)
         self.progress("sequence", 1, 1)
         timings["sequence"] = time.perf_counter() - t
         rounds = 0
@@ -302,8 +393,9 @@ class TourPlanner:
                 seqr.learn({pair: UNSOLVED_COST_S})
                 self._edge_free[(min(pair), max(pair))] = False
                 budget = o.budget_s(len(cands)) * REFINE_SHARE
-                res = seqr.solve(budget, o.seed + 200 + unsolved, o.effort, res.nodes, True)
-                res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
+                seen = []
+                res = seqr.solve(budget, o.seed + 200 + unsolved, o.effort, res.nodes, True, seen)
+                res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands), seen)
                 continue
             if seqr is None or res.nodes is None or rounds >= o.refine_rounds:
                 return route, segments, res, rounds
@@ -321,8 +413,9 @@ class TourPlanner:
             measured_pairs.update((v, u) for u, v in measured)
             seqr.learn(measured)
             budget = o.budget_s(len(cands)) * REFINE_SHARE
-            new = seqr.solve(budget, o.seed + rounds, o.effort, warm=res.nodes, repair=True)
-            new = self._avoid_colliding_edges(seqr, new, cache.checker, len(cands))
+            seen = []
+            new = seqr.solve(budget, o.seed + rounds, o.effort, res.nodes, True, seen)
+            new = self._avoid_colliding_edges(seqr, new, cache.checker, len(cands), seen)
             timings["sequence"] += time.perf_counter() - t
             if new.nodes == res.nodes:
                 return route, segments, new, rounds
@@ -391,6 +484,7 @@ class TourPlanner:
             "roadmap_segments": sum(s.path.via_roadmap for s in segments),
             "roadmap_edges_checked": self._roadmap.checked,
             "lazy_rounds": self._lazy_rounds,
+            "lazy_siblings_blocked": self._siblings,
             "roadmap_edges_blocked": sum(not f for f in self._roadmap.free.values()),
             "collision_checks": checker.checks,
         }
