@@ -33,6 +33,7 @@ from planner.protocols import ArmLike, CellLike
 from planner.roadmap import Roadmap, build_roadmap, detour_costs
 from planner.segments import Segment, SegmentCache
 from planner.sequence import GtspSequencer, SequenceResult
+from planner.shared import SharedPlan, options_key, unpack
 from planner.timing import JointLimits, TimedMotion
 from planner.tour import LeftOut, Stop, Tour
 from planner.trajectory import Dwell, sample_timeline
@@ -350,33 +351,33 @@ class TourPlanner:
 
     def _sequence_and_paths(
         self,
-        home: NDArray[np.float64],
-        cands: list[HoleCandidates],
+        shared: SharedPlan,
         limits: JointLimits,
         cache: SegmentCache,
         timings: dict[str, float],
     ) -> tuple[_Route, list[Segment], SequenceResult, int]:
         """Sequence, avoid colliding edges, plan the segments, feed measured detours back."""
         o = self.options
+        home, cands = shared.home, shared.candidates
         t = time.perf_counter()
         self.progress("sequence", 0, 1)
-        self._edge_free: dict[tuple[int, int], bool] = {}
-        self._roadmap = Roadmap()
+        self._edge_free = shared.edge_free
+        self._roadmap = shared.roadmap
         self._lazy_rounds = 0
         self._coarse_free: set[tuple[int, int]] = set()  # free at the coarse resolution
         self._siblings = 0
-        if self.sequencer is not None:
+        seqr = shared.sequencer
+        if self.sequencer is not None or seqr is None:
             res = self.sequencer(home, cands, limits)
             seqr = None
         else:
-            seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
-            self._build_roadmap(seqr, cache.checker)
+            self._batch = BatchEdgeChecker(cache.checker)
             self._coarse_batch = BatchEdgeChecker(cache.checker.coarser(ROADMAP_COARSENESS))
             seen: list[list[int]] = []
             res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort, record=seen)
             res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands), seen)
         self.progress("sequence", 1, 1)
-        timings["sequence"] = time.perf_counter() - t
+        timings["sequence"] = timings.get("sequence", 0.0) + time.perf_counter() - t
         rounds = 0
         measured_pairs: set[tuple[int, int]] = set()
         unsolved = 0
@@ -453,22 +454,56 @@ class TourPlanner:
             clock += o.dwell_s
         return stops, timeline, clock
 
-    def plan(self, cell: CellLike) -> Tour:
-        """Plan the tour of ``cell`` (see module docstring). Raises :class:`PlanningError`."""
+    def prepare(self, cell: CellLike) -> SharedPlan:
+        """The seed-independent part of planning ``cell`` (:mod:`planner.shared`): viewpoints,
+        the GTSP's nodes and costs, the roadmap."""
         o = self.options
-        started = time.perf_counter()
-        timings: dict[str, float] = {}
+        cpu = time.process_time()
         arm = cell.build_arm()
+        self._arm = arm
         limits = JointLimits.from_arm(arm)
         home = self._home(arm, cell)
         checker = MotionChecker(arm, np.radians(o.joint_step_deg), o.tcp_step_m)
+        t = time.perf_counter()
+        cands, left = self._viewpoints(arm, cell)
+        timings = {"viewpoints": time.perf_counter() - t}
+        t = time.perf_counter()
+        self._edge_free: dict[tuple[int, int], bool] = {}
+        self._roadmap = Roadmap()
+        seqr = None
+        if self.sequencer is None:
+            self.progress("sequence", 0, 1)
+            seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
+            self._build_roadmap(seqr, checker)
+        timings["sequence"] = time.perf_counter() - t
+        return SharedPlan(
+            cell_sha256(cell), options_key(o), home, cands, left, seqr, self._roadmap,
+            self._edge_free, checker.checks, timings, time.process_time() - cpu,
+        )  # fmt: skip
+
+    def plan(self, cell: CellLike, shared: SharedPlan | bytes | None = None) -> Tour:
+        """Plan the tour of ``cell`` (see module docstring). Raises :class:`PlanningError`.
+
+        ``shared``: the seed-independent part from :meth:`prepare` (or :func:`pack`) of the
+        same cell and options, any seed; this start then works on its own copy of it."""
+        o = self.options
+        started = time.perf_counter()
+        if shared is None:
+            shared = self.prepare(cell)
+            arm = self._arm
+        else:
+            shared = unpack(shared)
+            shared.check(cell_sha256(cell), o)
+            arm = cell.build_arm()
+        timings = dict(shared.timings_s)
+        limits = JointLimits.from_arm(arm)
+        home, left = shared.home, shared.left_out
+        checker = MotionChecker(arm, np.radians(o.joint_step_deg), o.tcp_step_m)
+        checker.checks = shared.collision_checks
         cache = SegmentCache(
             checker, limits, o.seed, o.segment_time_s, o.dt, o.pass_through_waypoints
         )
-        t = time.perf_counter()
-        cands, left = self._viewpoints(arm, cell)
-        timings["viewpoints"] = time.perf_counter() - t
-        route, segments, seq, rounds = self._sequence_and_paths(home, cands, limits, cache, timings)
+        route, segments, seq, rounds = self._sequence_and_paths(shared, limits, cache, timings)
         timings["paths"] = cache.path_time_s
         t = time.perf_counter()
         stops, timeline, cycle = self._stops(arm, route, segments)
