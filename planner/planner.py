@@ -50,10 +50,16 @@ REFINE_SHARE = 0.15
 #: at most this many lazy re-sequencing rounds ...
 LAZY_ROUNDS = 60
 #: ... and a safety cap in time, as a multiple of the sequencing budget
-LAZY_BUDGET_SHARE = 3.0
+LAZY_BUDGET_SHARE = 20.0
 #: a colliding tour motion: this many of the cheapest unknown motions between the same two
 #: holes (other candidates) are checked with it
 SIBLINGS = 8
+#: ... and when a round's tour had at least this many colliding motions (a cluttered cell),
+#: while all of a batch collide, twice as many more (probed, see PROBE_COARSENESS)
+CLUTTERED_HITS = 4
+#: probes are this many times coarser than the set resolution (a handful of samples per
+#: motion: a colliding one proves the collision, a free one proves nothing)
+PROBE_COARSENESS = 48.0
 #: a motion OMPL could not plan costs this much (s) and the tour is re-sequenced, this many times
 UNSOLVED_COST_S = 1000.0
 MAX_UNSOLVED = 5
@@ -305,36 +311,46 @@ class TourPlanner:
         self, seqr: GtspSequencer, hit: list[tuple[int, int]], checker: MotionChecker
     ) -> None:
         """The motions between the same two holes as a colliding tour motion, by other
-        candidates, that look cheaper than its detour: checked coarse in one batch, the
-        colliding ones learned (the next search would otherwise try them one by one)."""
+        candidates, that look cheaper than its detour: the ``SIBLINGS`` cheapest unknown ones
+        checked coarse in one batch, the colliding ones learned (the next search would try
+        them one by one); while all of a batch collide (an obstacle between the two holes),
+        the next twice as many."""
         group = [np.array([0]), *seqr.groups]
-        todo: set[tuple[int, int]] = set()
+        queue = {}
         for u, v in hit:
             a, b = group[int(seqr.owner[u]) + 1], group[int(seqr.owner[v]) + 1]
             C = seqr.G[np.ix_(a, b)]
-            found = 0
-            for flat in np.argsort(C, axis=None, kind="stable"):
-                i, j = divmod(int(flat), len(b))
-                if found == SIBLINGS or not C[i, j] < seqr.G[u, v]:
-                    break
-                key = (min(int(a[i]), int(b[j])), max(int(a[i]), int(b[j])))
-                if key not in self._edge_free and key not in self._coarse_free:
-                    todo.add(key)
-                    found += 1
-        if not todo:
-            return
-        keys = sorted(todo)
-        free = self._free(self._coarse_batch, seqr, keys, checker)
-        blocked = []
-        for key, f in zip(keys, free.tolist(), strict=True):
-            if f:
-                self._coarse_free.add(key)
-            else:
-                self._edge_free[key] = False
-                blocked.append(key)
-        self._siblings += len(blocked)
-        if blocked:
-            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
+            order = np.argsort(C, axis=None, kind="stable")
+            pairs = [divmod(int(f), len(b)) for f in order[C.ravel()[order] < seqr.G[u, v]]]
+            keys = [(min(int(a[i]), int(b[j])), max(int(a[i]), int(b[j]))) for i, j in pairs]
+            queue[(u, v)] = [k for k in keys if k not in self._edge_free]
+        size = SIBLINGS
+        grow = len(hit) >= CLUTTERED_HITS
+        while queue and (grow or size == SIBLINGS):
+            batches = {}
+            for e, keys in queue.items():
+                todo = [k for k in keys if k not in self._edge_free and k not in self._coarse_free]
+                batches[e], queue[e] = todo[:size], todo[size:]
+            keys = sorted({k for ks in batches.values() for k in ks})
+            if not keys:
+                return
+            batch = self._coarse_batch if size == SIBLINGS else self._probe_batch
+            free = dict(zip(keys, self._free(batch, seqr, keys, checker), strict=True))
+            blocked = [k for k in keys if not free[k]]
+            for k in keys:
+                if not free[k]:
+                    self._edge_free[k] = False
+                elif batch is self._coarse_batch:  # a probe's "free" proves nothing
+                    self._coarse_free.add(k)
+            self._siblings += len(blocked)
+            if blocked:
+                seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
+            queue = {
+                e: rest
+                for e, rest in queue.items()
+                if rest and batches[e] and not any(free[k] for k in batches[e])
+            }
+            size *= 2
 
     @staticmethod
     def _free(
@@ -373,6 +389,7 @@ class TourPlanner:
         else:
             self._batch = BatchEdgeChecker(cache.checker)
             self._coarse_batch = BatchEdgeChecker(cache.checker.coarser(ROADMAP_COARSENESS))
+            self._probe_batch = BatchEdgeChecker(cache.checker.coarser(PROBE_COARSENESS))
             seen: list[list[int]] = []
             res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort, record=seen)
             res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands), seen)
