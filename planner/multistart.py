@@ -106,6 +106,9 @@ def plan_multistart(
             "start_cycle_times_s": [
                 r.cycle_time_s if isinstance(r, Tour) else None for r in results
             ],
+            "start_cpu_times_s": [
+                r.settings["cpu_time_s"] if isinstance(r, Tour) else None for r in results
+            ],
             "engine": engine.name,
             "shared": share,
         }
