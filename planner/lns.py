@@ -11,6 +11,10 @@ node of every hole exactly for the new order (layered shortest path). A new
 tour replaces the current one when it is not worse by more than a threshold
 that shrinks to zero; the best tour is returned.
 
+``record`` (optional): every tour the search accepts (as its current or best tour) is
+appended to it as its node list, so that a caller checking motions lazily can check the
+motions of the tours the search is heading for in one batch, not one tour at a time.
+
 Determinism: all randomness comes from ``numpy.random.default_rng(seed)``; the
 search stops after ``max_iterations`` or after ``patience`` iterations without
 a new best, whichever comes first. ``time_limit_s`` is a hard cap on the thread's CPU
@@ -54,18 +58,28 @@ class LnsResult:
 
 
 def layered_nodes(
-    G: NDArray[np.floating], layers: Sequence[NDArray[np.int64]]
+    G: NDArray[np.floating],
+    layers: Sequence[NDArray[np.int64]],
+    spans: Sequence[tuple[int, int]] | None = None,
 ) -> tuple[list[int], float]:
-    """Exact best node per layer for a fixed order of layers, home (node 0) at both ends."""
+    """Exact best node per layer for a fixed order of layers, home (node 0) at both ends.
+
+    ``spans`` (optional): ``(first, end)`` of each layer when it is the contiguous range
+    ``first .. end-1`` of nodes (then the blocks of ``G`` are read as views, not copies:
+    the same numbers, a third of the time)."""
     if not layers:
         return [], 0.0
+    blocks = (
+        [G[a0:a1, b0:b1] for (a0, a1), (b0, b1) in itertools.pairwise(spans)]
+        if spans is not None
+        else [G[prev[:, None], cur[None, :]] for prev, cur in itertools.pairwise(layers)]
+    )
     dist = G[0, layers[0]].astype(float)
     back = []
-    for prev, cur in itertools.pairwise(layers):
-        total = dist[:, None] + G[prev[:, None], cur[None, :]]
-        arg = np.argmin(total, axis=0)
-        back.append(arg)
-        dist = total[arg, np.arange(len(cur))]
+    for block in blocks:
+        total = dist[:, None] + block
+        back.append(np.argmin(total, axis=0))
+        dist = total.min(axis=0)
     total = dist + G[layers[-1], 0]
     pick = [int(np.argmin(total))]
     cost = float(total[pick[0]])
@@ -75,18 +89,35 @@ def layered_nodes(
     return [int(layer[p]) for layer, p in zip(layers, pick, strict=True)], cost
 
 
+def _span(group: NDArray[np.int64]) -> tuple[int, int] | None:
+    """``(first, end)`` when ``group`` is the range ``first .. end-1``, else None."""
+    if len(group) and np.array_equal(group, np.arange(group[0], group[0] + len(group))):
+        return int(group[0]), int(group[0]) + len(group)
+    return None
+
+
 class GtspLns:
     """The search over one problem instance (see module docstring)."""
 
     def __init__(
-        self, G: NDArray[np.floating], groups: Sequence[NDArray[np.int64]], seed: int
+        self,
+        G: NDArray[np.floating],
+        groups: Sequence[NDArray[np.int64]],
+        seed: int,
+        record: list[list[int]] | None = None,
     ) -> None:
         self.G = G
         self.groups = [np.asarray(g, dtype=np.int64) for g in groups]
         self.rng = np.random.default_rng(seed)
+        self.record = record
+        spans = [_span(g) for g in self.groups]
+        self.spans: list[tuple[int, int]] | None = (
+            None if any(s is None for s in spans) else spans  # type: ignore[assignment]
+        )
 
     def _rechoose(self, order: list[int]) -> tuple[list[int], list[int], float]:
-        nodes, cost = layered_nodes(self.G, [self.groups[h] for h in order])
+        spans = None if self.spans is None else [self.spans[h] for h in order]
+        nodes, cost = layered_nodes(self.G, [self.groups[h] for h in order], spans)
         return order, nodes, cost
 
     def _local(
@@ -136,11 +167,12 @@ class GtspLns:
         for h in removed:
             path = np.array([0, *nodes, 0])
             cand = self.groups[h]
-            extra = (
-                self.G[np.ix_(path[:-1], cand)]
-                + self.G[np.ix_(cand, path[1:])].T
-                - self.G[path[:-1], path[1:]][:, None]
-            )
+            if self.spans is not None:  # views of the contiguous columns: the same numbers
+                c0, c1 = self.spans[h]
+                into, out = self.G[path[:-1], c0:c1], self.G[c0:c1, path[1:]].T
+            else:
+                into, out = self.G[np.ix_(path[:-1], cand)], self.G[np.ix_(cand, path[1:])].T
+            extra = into + out - self.G[path[:-1], path[1:]][:, None]
             e, c = divmod(int(np.argmin(extra)), extra.shape[1])
             order.insert(e, h)
             nodes.insert(e, int(cand[c]))
@@ -170,6 +202,8 @@ class GtspLns:
             threshold = settings.start_threshold * best[2] * (1 - it / settings.max_iterations)
             if new[2] < cur[2] + threshold:
                 cur = new
+                if self.record is not None:
+                    self.record.append(list(new[1]))
             if new[2] < best[2] - 1e-9:
                 best, since_best = new, 0
             else:

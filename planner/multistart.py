@@ -1,10 +1,13 @@
 """Multi-start planning: independent starts (seeds) on an engine, the best tour kept.
 
-Start ``k`` of ``starts`` plans the whole tour (viewpoints, sequence, paths, timing)
-with seed ``options.seed × starts + k``, so the sets of start seeds of two base seeds
-never overlap. Each start is deterministic for its seed (work limits, not clocks;
-see :mod:`planner.sequence`) and runs in a fresh process, so the best tour — the
-shortest cycle time, ties to the lowest seed — is the same whichever engine
+The seed-independent part (viewpoints, the GTSP's nodes and costs, the roadmap;
+:mod:`planner.shared`) is computed once, in this process, while the engine's workers
+start up; start ``k`` of ``starts`` then runs the seed-dependent stages (sequence, lazy
+rounds, paths, timing) on its own copy with seed ``options.seed × starts + k``, so the
+sets of start seeds of two base seeds never overlap. Each start is deterministic for
+its seed (work limits, not clocks; see :mod:`planner.sequence`), gives the same tour
+with or without the shared part handed to it, and runs in a fresh process, so the best
+tour — the shortest cycle time, ties to the lowest seed — is the same whichever engine
 (:mod:`planner.engines`) ran the starts.
 """
 
@@ -20,6 +23,7 @@ from planner.errors import PlanningError, StartsFailedError
 from planner.options import Options
 from planner.planner import TourPlanner
 from planner.protocols import CellLike
+from planner.shared import pack
 from planner.tour import Tour
 
 #: independent starts of ``holecell plan`` (fixed, so the tour does not depend on the machine)
@@ -31,14 +35,15 @@ def start_seeds(options: Options, starts: int) -> list[int]:
     return [options.seed * starts + k for k in range(starts)]
 
 
-def plan_one(cell: CellLike, options: Options) -> Tour | str:
+def plan_one(cell: CellLike, options: Options, shared: bytes | None = None) -> Tour | str:
     """One start (runs in a worker): the tour (``settings["cpu_time_s"]``: the CPU time of
-    the start, every thread), or the planning error's message."""
+    the start, every thread; with ``shared`` (:func:`planner.shared.pack`) the start's own
+    part only), or the planning error's message."""
     # the summary lists holes left out once; the starts need not warn about them each
     logging.getLogger("planner").setLevel(logging.ERROR)
     cpu = time.process_time()
     try:
-        tour = TourPlanner(options).plan(cell)
+        tour = TourPlanner(options).plan(cell, shared)
         tour.settings["cpu_time_s"] = time.process_time() - cpu
     except PlanningError as exc:
         return f"{type(exc).__name__}: {exc}"
@@ -58,16 +63,40 @@ def best_tour(results: list[Tour | str], seeds: list[int]) -> Tour:
 
 
 def plan_multistart(
-    cell: CellLike, options: Options, starts: int, engine: Engine | None = None
+    cell: CellLike,
+    options: Options,
+    starts: int,
+    engine: Engine | None = None,
+    share: bool = True,
 ) -> Tour:
-    """Plan ``starts`` independent starts of ``cell`` on ``engine`` (default: local cores)."""
+    """Plan ``starts`` independent starts of ``cell`` on ``engine`` (default: local cores).
+
+    ``share``: compute the seed-independent part once here and hand it to the starts (the
+    same tours; without it every start computes it itself)."""
     if starts < 1:
         raise PlanningError(f"starts must be at least 1, got {starts}")
     engine = engine or LocalEngine()
     started = time.perf_counter()
     seeds = start_seeds(options, starts)
     calls = [(cell, dataclasses.replace(options, seed=s)) for s in seeds]
-    results = engine.map(plan_one, calls)
+    warm_up = getattr(engine, "warm_up", None)
+    if warm_up is not None:  # workers import the planner while the shared part is computed
+        warm_up([type(cell).__module__])
+    shared_info: dict[str, float] = {}
+    blob = None
+    if share:
+        try:
+            shared = TourPlanner(options).prepare(cell)
+        finally:
+            gc.collect()
+        t = time.perf_counter()
+        blob = pack(shared)
+        shared_info = {
+            "shared_cpu_time_s": shared.cpu_time_s,
+            "shared_bytes": len(blob),
+            "shared_pack_s": time.perf_counter() - t,
+        }
+    results = engine.map(plan_one, calls, blob)
     best = best_tour(results, seeds)
     best.settings.update(
         {
@@ -77,8 +106,13 @@ def plan_multistart(
             "start_cycle_times_s": [
                 r.cycle_time_s if isinstance(r, Tour) else None for r in results
             ],
+            "start_cpu_times_s": [
+                r.settings["cpu_time_s"] if isinstance(r, Tour) else None for r in results
+            ],
             "engine": engine.name,
+            "shared": share,
         }
+        | shared_info
     )
     best.planning_time_s = time.perf_counter() - started
     return best

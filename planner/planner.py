@@ -9,7 +9,6 @@ Library code reports progress through an optional callback
 from __future__ import annotations
 
 import hashlib
-import itertools
 import logging
 import time
 from collections.abc import Callable
@@ -27,12 +26,14 @@ from planner.errors import (
     TourCellMismatchError,
     UnreachableHoleError,
 )
+from planner.lazy_edges import PROBE_COARSENESS, REFINE_SHARE, LazyEdgeChecks
 from planner.options import Options
 from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
 from planner.roadmap import Roadmap, build_roadmap, detour_costs
 from planner.segments import Segment, SegmentCache
 from planner.sequence import GtspSequencer, SequenceResult
+from planner.shared import SharedPlan, options_key, unpack
 from planner.timing import JointLimits, TimedMotion
 from planner.tour import LeftOut, Stop, Tour
 from planner.trajectory import Dwell, sample_timeline
@@ -44,12 +45,6 @@ ProgressCallback = Callable[[str, int, int], None]
 #: a replacement sequencer: (home q, candidates per hole, limits) -> SequenceResult
 Sequencer = Callable[[NDArray[np.float64], list[HoleCandidates], JointLimits], SequenceResult]
 STAGES = ("viewpoints", "sequence", "paths", "timing")
-#: time cap of each repair search after costs changed, as a share of the sequencing budget
-REFINE_SHARE = 0.15
-#: at most this many lazy re-sequencing rounds ...
-LAZY_ROUNDS = 60
-#: ... and a safety cap in time, as a multiple of the sequencing budget
-LAZY_BUDGET_SHARE = 3.0
 #: a motion OMPL could not plan costs this much (s) and the tour is re-sequenced, this many times
 UNSOLVED_COST_S = 1000.0
 MAX_UNSOLVED = 5
@@ -100,7 +95,7 @@ class _Route:
     candidates: list[HoleCandidates]
 
 
-class TourPlanner:
+class TourPlanner(LazyEdgeChecks):
     """Plans inspection tours with fixed :class:`Options`; :meth:`plan` does one cell.
 
     ``sequencer`` replaces the built-in sequencing stage (benchmarks use it to run
@@ -219,73 +214,36 @@ class TourPlanner:
                 blocked += [(u, v), (v, u)]
         seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
 
-    def _avoid_colliding_edges(
-        self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker, n_holes: int
-    ) -> SequenceResult:
-        """Lazy collision checking: the tour's unchecked edges are checked in one batch at
-        the set resolution; colliding ones get their roadmap detour cost; re-sequence.
-
-        Stops after ``LAZY_ROUNDS`` rounds (work, not time: the same seed gives the same
-        tour); the time cap ``LAZY_BUDGET_SHARE`` × budget only binds on a crawling machine."""
-        o = self.options
-        started = time.thread_time()
-        for k in range(LAZY_ROUNDS + 1):
-            blocked = self._blocked_on_tour(seqr, res, checker)
-            out_of_work = k == LAZY_ROUNDS
-            out_of_time = time.thread_time() - started > LAZY_BUDGET_SHARE * o.budget_s(n_holes)
-            if not blocked or out_of_work or out_of_time:
-                break
-            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
-            budget = o.budget_s(n_holes) * REFINE_SHARE
-            res = seqr.solve(budget, o.seed + 100 + k, o.effort, warm=res.nodes, repair=True)
-        self._lazy_rounds += k
-        return res
-
-    def _blocked_on_tour(
-        self, seqr: GtspSequencer, res: SequenceResult, checker: MotionChecker
-    ) -> list[tuple[int, int]]:
-        """Check the tour's unchecked edges (one batch, set resolution); the colliding ones
-        whose cost is not yet a detour's (in the direction travelled)."""
-        path = [0, *(res.nodes or []), 0]
-        keys = [(min(u, v), max(u, v)) for u, v in itertools.pairwise(path)]
-        todo = sorted({key for key in keys if key not in self._edge_free})
-        if todo:
-            e = np.array(todo)
-            free = self._batch.free(seqr.nodes[e[:, 0]], seqr.nodes[e[:, 1]])
-            self._edge_free.update(zip(todo, free.tolist(), strict=True))
-        checker.checks += self._batch.checks
-        self._batch.checks = 0
-        return [
-            (u, v)
-            for (u, v), key in zip(itertools.pairwise(path), keys, strict=True)
-            if not self._edge_free[key] and (u, v) not in seqr.learned
-        ]
-
     def _sequence_and_paths(
         self,
-        home: NDArray[np.float64],
-        cands: list[HoleCandidates],
+        shared: SharedPlan,
         limits: JointLimits,
         cache: SegmentCache,
         timings: dict[str, float],
     ) -> tuple[_Route, list[Segment], SequenceResult, int]:
         """Sequence, avoid colliding edges, plan the segments, feed measured detours back."""
         o = self.options
+        home, cands = shared.home, shared.candidates
         t = time.perf_counter()
         self.progress("sequence", 0, 1)
-        self._edge_free: dict[tuple[int, int], bool] = {}
-        self._roadmap = Roadmap()
+        self._edge_free = shared.edge_free
+        self._roadmap = shared.roadmap
         self._lazy_rounds = 0
-        if self.sequencer is not None:
+        self._coarse_free: set[tuple[int, int]] = set()  # free at the coarse resolution
+        self._siblings = 0
+        seqr = shared.sequencer
+        if self.sequencer is not None or seqr is None:
             res = self.sequencer(home, cands, limits)
             seqr = None
         else:
-            seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
-            self._build_roadmap(seqr, cache.checker)
-            res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort)
-            res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
+            self._batch = BatchEdgeChecker(cache.checker)
+            self._coarse_batch = BatchEdgeChecker(cache.checker.coarser(ROADMAP_COARSENESS))
+            self._probe_batch = BatchEdgeChecker(cache.checker.coarser(PROBE_COARSENESS))
+            seen: list[list[int]] = []
+            res = seqr.solve(o.budget_s(len(cands)), o.seed, o.effort, record=seen)
+            res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands), seen)
         self.progress("sequence", 1, 1)
-        timings["sequence"] = time.perf_counter() - t
+        timings["sequence"] = timings.get("sequence", 0.0) + time.perf_counter() - t
         rounds = 0
         measured_pairs: set[tuple[int, int]] = set()
         unsolved = 0
@@ -302,8 +260,9 @@ class TourPlanner:
                 seqr.learn({pair: UNSOLVED_COST_S})
                 self._edge_free[(min(pair), max(pair))] = False
                 budget = o.budget_s(len(cands)) * REFINE_SHARE
-                res = seqr.solve(budget, o.seed + 200 + unsolved, o.effort, res.nodes, True)
-                res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands))
+                seen = []
+                res = seqr.solve(budget, o.seed + 200 + unsolved, o.effort, res.nodes, True, seen)
+                res = self._avoid_colliding_edges(seqr, res, cache.checker, len(cands), seen)
                 continue
             if seqr is None or res.nodes is None or rounds >= o.refine_rounds:
                 return route, segments, res, rounds
@@ -321,8 +280,9 @@ class TourPlanner:
             measured_pairs.update((v, u) for u, v in measured)
             seqr.learn(measured)
             budget = o.budget_s(len(cands)) * REFINE_SHARE
-            new = seqr.solve(budget, o.seed + rounds, o.effort, warm=res.nodes, repair=True)
-            new = self._avoid_colliding_edges(seqr, new, cache.checker, len(cands))
+            seen = []
+            new = seqr.solve(budget, o.seed + rounds, o.effort, res.nodes, True, seen)
+            new = self._avoid_colliding_edges(seqr, new, cache.checker, len(cands), seen)
             timings["sequence"] += time.perf_counter() - t
             if new.nodes == res.nodes:
                 return route, segments, new, rounds
@@ -360,22 +320,56 @@ class TourPlanner:
             clock += o.dwell_s
         return stops, timeline, clock
 
-    def plan(self, cell: CellLike) -> Tour:
-        """Plan the tour of ``cell`` (see module docstring). Raises :class:`PlanningError`."""
+    def prepare(self, cell: CellLike) -> SharedPlan:
+        """The seed-independent part of planning ``cell`` (:mod:`planner.shared`): viewpoints,
+        the GTSP's nodes and costs, the roadmap."""
         o = self.options
-        started = time.perf_counter()
-        timings: dict[str, float] = {}
+        cpu = time.process_time()
         arm = cell.build_arm()
+        self._arm = arm
         limits = JointLimits.from_arm(arm)
         home = self._home(arm, cell)
         checker = MotionChecker(arm, np.radians(o.joint_step_deg), o.tcp_step_m)
+        t = time.perf_counter()
+        cands, left = self._viewpoints(arm, cell)
+        timings = {"viewpoints": time.perf_counter() - t}
+        t = time.perf_counter()
+        self._edge_free: dict[tuple[int, int], bool] = {}
+        self._roadmap = Roadmap()
+        seqr = None
+        if self.sequencer is None:
+            self.progress("sequence", 0, 1)
+            seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
+            self._build_roadmap(seqr, checker)
+        timings["sequence"] = time.perf_counter() - t
+        return SharedPlan(
+            cell_sha256(cell), options_key(o), home, cands, left, seqr, self._roadmap,
+            self._edge_free, checker.checks, timings, time.process_time() - cpu,
+        )  # fmt: skip
+
+    def plan(self, cell: CellLike, shared: SharedPlan | bytes | None = None) -> Tour:
+        """Plan the tour of ``cell`` (see module docstring). Raises :class:`PlanningError`.
+
+        ``shared``: the seed-independent part from :meth:`prepare` (or :func:`pack`) of the
+        same cell and options, any seed; this start then works on its own copy of it."""
+        o = self.options
+        started = time.perf_counter()
+        if shared is None:
+            shared = self.prepare(cell)
+            arm = self._arm
+        else:
+            shared = unpack(shared)
+            shared.check(cell_sha256(cell), o)
+            arm = cell.build_arm()
+        timings = dict(shared.timings_s)
+        limits = JointLimits.from_arm(arm)
+        home, left = shared.home, shared.left_out
+        checker = MotionChecker(arm, np.radians(o.joint_step_deg), o.tcp_step_m)
+        checker.checks = shared.collision_checks
         cache = SegmentCache(
             checker, limits, o.seed, o.segment_time_s, o.dt, o.pass_through_waypoints
         )
-        t = time.perf_counter()
-        cands, left = self._viewpoints(arm, cell)
-        timings["viewpoints"] = time.perf_counter() - t
-        route, segments, seq, rounds = self._sequence_and_paths(home, cands, limits, cache, timings)
+        route, segments, seq, rounds = self._sequence_and_paths(shared, limits, cache, timings)
         timings["paths"] = cache.path_time_s
         t = time.perf_counter()
         stops, timeline, cycle = self._stops(arm, route, segments)
@@ -391,6 +385,7 @@ class TourPlanner:
             "roadmap_segments": sum(s.path.via_roadmap for s in segments),
             "roadmap_edges_checked": self._roadmap.checked,
             "lazy_rounds": self._lazy_rounds,
+            "lazy_siblings_blocked": self._siblings,
             "roadmap_edges_blocked": sum(not f for f in self._roadmap.free.values()),
             "collision_checks": checker.checks,
         }

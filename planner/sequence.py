@@ -233,11 +233,14 @@ class GtspSequencer:
         effort: float = 1.0,
         warm: Sequence[int] | None = None,
         repair: bool = False,
+        record: list[list[int]] | None = None,
     ) -> SequenceResult:
         """Search a tour; ``warm`` (visited nodes) seeds the LNS instead of its greedy start.
 
         ``repair`` (with ``warm``): a short search that mends a tour after some of its
-        costs changed (work 20 + n/10 iterations, scaled by ``effort``).
+        costs changed (work 20 + n/10 iterations, scaled by ``effort``). ``record``: the
+        LNS appends the node lists of the tours it accepted (:mod:`planner.lns`); the other
+        methods leave it empty.
         """
         started = time.perf_counter()
         n = len(self.candidates)
@@ -249,7 +252,7 @@ class GtspSequencer:
                 time_limit_s=time_budget_s,
             )
             start = None if warm is None else [int(self.owner[v]) for v in warm]
-            found = GtspLns(self.G, self.groups, seed).run(settings, start)
+            found = GtspLns(self.G, self.groups, seed, record).run(settings, start)
             visited, hit = found.nodes, found.hit_time_limit
         elif self.method == "pyvrp":
             base, per_hole = PYVRP_ITERATIONS

@@ -12,8 +12,10 @@ import yaml
 from cell.config import builtin_cell_path, parse_cell
 from planner import Options
 from planner.engines import LocalEngine, RayEngine
-from planner.errors import EngineError, StartsFailedError
+from planner.errors import EngineError, PlanningError, StartsFailedError
 from planner.multistart import best_tour, plan_multistart, start_seeds
+from planner.planner import TourPlanner
+from planner.shared import pack
 
 
 def _cell(n_holes: int = 3):
@@ -60,3 +62,33 @@ def test_a_local_ray_instance_gives_the_same_best_tour_as_local_processes() -> N
     assert on_ray.settings["engine"].startswith("ray")
     assert on_ray.settings["start_cycle_times_s"] == local.settings["start_cycle_times_s"]
     assert np.array_equal(on_ray.trajectory, local.trajectory)
+
+
+def test_a_start_handed_the_shared_part_gives_the_same_tour_as_one_that_computed_it() -> None:
+    cell = _cell(4)
+    engine = LocalEngine(2)
+    shared = plan_multistart(cell, Options(seed=3), 2, engine, share=True)
+    alone = plan_multistart(cell, Options(seed=3), 2, engine, share=False)
+    assert shared.settings["shared"] and not alone.settings["shared"]
+    assert shared.settings["shared_bytes"] > 0
+    assert shared.settings["start_cycle_times_s"] == alone.settings["start_cycle_times_s"]
+    assert np.array_equal(shared.trajectory, alone.trajectory)
+    assert shared.settings["collision_checks"] == alone.settings["collision_checks"]
+    # the shared part's own work is not counted again in the start's CPU time
+    assert shared.settings["cpu_time_s"] < alone.settings["cpu_time_s"]
+    # ... and in this process (no OMPL segment on these holes: its seed is per process)
+    here = TourPlanner(Options(seed=6)).plan(cell)
+    assert here.settings["ompl_segments"] == 0
+    assert here.cycle_time_s == shared.settings["start_cycle_times_s"][0]
+
+
+def test_the_shared_part_of_another_cell_or_other_options_is_refused() -> None:
+    cell = _cell(2)
+    shared = TourPlanner(Options(seed=0)).prepare(cell)
+    # another seed is what the shared part is for
+    tour = TourPlanner(Options(seed=5)).plan(cell, pack(shared))
+    assert len(tour.stops) == 2
+    with pytest.raises(PlanningError, match="other roll_step_deg"):
+        TourPlanner(Options(roll_step_deg=30.0)).plan(cell, shared)
+    with pytest.raises(PlanningError, match="another cell"):
+        TourPlanner(Options()).plan(_cell(3), shared)
