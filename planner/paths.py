@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,7 +46,14 @@ def seed_ompl(seed: int) -> None:
 
 
 def _interpolation_order(n: int) -> NDArray[np.int64]:
-    """Indices 1..n-1 coarse to fine (a van der Corput order), so collisions show early."""
+    """Indices 1..n-1 coarse to fine (a van der Corput order), so collisions show early.
+
+    Cached per ``n`` (read-only arrays: many motions share a sample count)."""
+    return _order_of(int(n))
+
+
+@lru_cache(maxsize=4096)
+def _order_of(n: int) -> NDArray[np.int64]:
     order, seen = [], set()
     step = 1 << max(int(np.ceil(np.log2(max(n, 2)))), 1)
     while step >= 1:
@@ -54,7 +62,16 @@ def _interpolation_order(n: int) -> NDArray[np.int64]:
                 seen.add(i)
                 order.append(i)
         step //= 2
-    return np.array(order, dtype=np.int64)
+    out = np.array(order, dtype=np.int64)
+    out.flags.writeable = False
+    return out
+
+
+def tcp_positions(arm: ArmLike, Q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """TCP positions (N, 3) m of configurations ``Q`` (N, dof): the arm's fast point chain
+    (``robots.Arm.tcp_positions``) where it has one, else its batched ``fk_dh``."""
+    fast = getattr(arm, "tcp_positions", None)
+    return fast(Q) if fast is not None else arm.fk_dh(Q, "tcp")[:, :3, 3]
 
 
 class MotionChecker:
@@ -89,7 +106,7 @@ class MotionChecker:
         for _ in range(8):
             t = np.linspace(0.0, 1.0, n + 1)[:, None]
             Q = q_a + t * (q_b - q_a)
-            tcp = self.arm.fk_dh(Q, "tcp")[:, :3, 3]
+            tcp = tcp_positions(self.arm, Q)
             worst = np.linalg.norm(np.diff(tcp, axis=0), axis=1).max()
             if worst <= self.tcp_step:
                 return Q
@@ -220,13 +237,15 @@ class SegmentPlanner:
         time_s: float,
         names: tuple[str, str],
         via: NDArray[np.float64] | None = None,
+        straight_free: bool = False,
     ) -> SegmentPath:
         """A free path ``q_a`` to ``q_b``, else :class:`SegmentPlanningError` naming ``names``.
 
         ``via`` (rows, rad): a detour through known free configurations, tried (validated at
         the set resolution, shortcut where straight motions are free) before OMPL.
+        ``straight_free``: the caller checked the straight motion at the set resolution.
         """
-        if self.checker.segment_free(q_a, q_b):
+        if straight_free or self.checker.segment_free(q_a, q_b):
             return SegmentPath(np.array([q_a, q_b]), planned=False)
         if via is not None and len(via):
             Q = np.vstack([q_a, via, q_b])

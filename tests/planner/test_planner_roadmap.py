@@ -44,3 +44,11 @@ def test_blocked_motions_cost_their_shortest_detour_through_free_ones() -> None:
     # node 4 is not on the roadmap: the estimate
     assert costs[(1, 4)] == pytest.approx(DETOUR_FACTOR * 8.0 + DETOUR_EXTRA_S)
     assert rm.via(1, 4) is None
+
+
+def test_concatenated_linspaces_equal_numpy_linspace_bit_for_bit() -> None:
+    from planner.edge_check import _linspaces
+
+    n = np.array([1, 2, 3, 7, 10, 33, 129])
+    want = np.concatenate([np.linspace(0.0, 1.0, m + 1) for m in n])
+    assert np.array_equal(_linspaces(n), want)
