@@ -15,19 +15,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from planner.paths import MotionChecker, _interpolation_order, tcp_positions
+from planner.paths import MotionChecker, _interpolation_order
+from planner.sampling import interior_samples, motion_counts
 from robots.collision_batch import BatchCollision
-
-
-def _linspaces(n: NDArray[np.int64]) -> NDArray[np.float64]:
-    """``np.linspace(0, 1, m + 1)`` for each ``m`` in ``n``, concatenated (the same values:
-    ``k * (1 / m)``, the last exactly 1)."""
-    reps = n + 1
-    first = np.concatenate([[0], np.cumsum(reps)[:-1]])
-    k = np.arange(int(reps.sum())) - np.repeat(first, reps)
-    t = k * np.repeat(1.0 / n, reps)
-    t[first + n] = 1.0
-    return t
 
 
 class BatchEdgeChecker:
@@ -43,29 +33,9 @@ class BatchEdgeChecker:
         self.checks = 0
 
     def _counts(self, A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.int64]:
-        """Steps per motion so that no joint moves more than the joint step and the TCP no
-        more than the TCP step between samples (all motions at once; the same arithmetic as
-        :meth:`MotionChecker.samples`, so the same counts)."""
+        """Steps per motion (the rule and arithmetic of :meth:`MotionChecker.samples`)."""
         c = self.checker
-        n = np.maximum(np.ceil(np.abs(B - A).max(axis=1) / c.joint_step), 1).astype(np.int64)
-        todo = np.arange(len(A))
-        for _ in range(8):
-            if not len(todo):
-                break
-            reps = n[todo] + 1
-            t = _linspaces(n[todo])[:, None]
-            idx = np.repeat(todo, reps)
-            Q = A[idx] + t * (B[idx] - A[idx])
-            tcp = tcp_positions(c.arm, Q)
-            step = np.linalg.norm(np.diff(tcp, axis=0), axis=1)
-            step[np.cumsum(reps)[:-1] - 1] = 0.0  # no step across two motions
-            worst = np.maximum.reduceat(
-                np.append(step, 0.0), np.concatenate([[0], np.cumsum(reps)[:-1]])
-            )
-            bad = worst > c.tcp_step
-            n[todo[bad]] = np.ceil(n[todo[bad]] * worst[bad] / c.tcp_step * 1.05).astype(np.int64)
-            todo = todo[bad]
-        return n
+        return motion_counts(c.arm, c.joint_step, c.tcp_step, A, B)
 
     def free(self, starts: NDArray[np.float64], ends: NDArray[np.float64]) -> NDArray[np.bool_]:
         """For each row pair (``starts[i]`` → ``ends[i]``, rad): True when the straight motion
@@ -76,13 +46,8 @@ class BatchEdgeChecker:
         n = self._counts(A, B)
         # every motion's interior samples, coarse to fine (the order of MotionChecker), in one
         # array: row j of motion i is A_i + t (B_i - A_i) with t = k / n_i as np.linspace
-        orders = [_interpolation_order(int(m)) for m in n]
+        Q, bounds = interior_samples(A, B, n, _interpolation_order)
         sizes = n - 1
-        k = np.concatenate(orders) if len(orders) else np.zeros(0, np.int64)
-        idx = np.repeat(np.arange(len(A)), sizes)
-        t = (k * np.repeat(1.0 / n, sizes))[:, None]
-        Q = A[idx] + t * (B[idx] - A[idx])
-        bounds = np.concatenate([[0], np.cumsum(sizes)])
         lo, hi = self.checker.lower, self.checker.upper
         row_in = np.all((lo <= Q) & (hi >= Q), axis=1)
         inner_in = np.ones(len(A), dtype=bool)

@@ -28,6 +28,7 @@ from ompl import util as ou
 
 from planner.errors import SegmentPlanningError
 from planner.protocols import ArmLike
+from planner.sampling import interior_samples, motion_counts, tcp_positions
 
 log = logging.getLogger(__name__)
 
@@ -65,13 +66,6 @@ def _order_of(n: int) -> NDArray[np.int64]:
     out = np.array(order, dtype=np.int64)
     out.flags.writeable = False
     return out
-
-
-def tcp_positions(arm: ArmLike, Q: NDArray[np.float64]) -> NDArray[np.float64]:
-    """TCP positions (N, 3) m of configurations ``Q`` (N, dof): the arm's fast point chain
-    (``robots.Arm.tcp_positions``) where it has one, else its batched ``fk_dh``."""
-    fast = getattr(arm, "tcp_positions", None)
-    return fast(Q) if fast is not None else arm.fk_dh(Q, "tcp")[:, :3, 3]
 
 
 class MotionChecker:
@@ -124,16 +118,43 @@ class MotionChecker:
             return False
         order = _interpolation_order(len(Q) - 1)
         self.checks += len(order)
-        return not any(self.arm.in_collision(Q[i]) for i in order)
+        return not self._any_collides(Q[order])
+
+    def _any_collides(self, Q: NDArray[np.float64]) -> bool:
+        """True when a row of ``Q`` collides, checked in row order up to the first hit: one
+        batch call where the arm offers it (``robots.Arm.in_collision_any``), else one by one.
+        """
+        batch = getattr(self.arm, "in_collision_any", None)
+        if batch is not None:
+            return bool(batch(Q))
+        return any(self.arm.in_collision(q) for q in Q)
 
     def polyline_free(self, Q: NDArray[np.float64]) -> bool:
-        """True when the motion through the rows of ``Q`` (straight between rows) is free."""
-        if not self.state_free(Q[0]):
+        """True when the motion through the rows of ``Q`` (straight between rows) is free.
+
+        The rows and every segment's samples within the limits, and none colliding; checked
+        in the order row 0, segment 1 coarse to fine, row 1, segment 2, ... (all segments'
+        samples made at once, :mod:`planner.sampling`; the same samples and answer as checking
+        one segment at a time).
+        """
+        Q = np.asarray(Q, dtype=float)
+        if len(Q) < 2:
+            return self.state_free(Q[0])
+        A, B = Q[:-1], Q[1:]
+        n = motion_counts(self.arm, self.joint_step, self.tcp_step, A, B)
+        inner, bounds = interior_samples(A, B, n, _interpolation_order)
+        last = A + 1.0 * (B - A)  # each segment's last sample (np.linspace's)
+        if not (self._inside(Q) and self._inside(inner) and self._inside(last)):
             return False
-        return all(
-            self.segment_free(Q[i], Q[i + 1]) and self.state_free(Q[i + 1])
-            for i in range(len(Q) - 1)
-        )
+        # row i goes before segment i's samples: its position is i + the samples before it
+        at = np.arange(len(Q)) + bounds
+        seq = np.empty((len(Q) + len(inner), Q.shape[1]))
+        mask = np.zeros(len(seq), dtype=bool)
+        mask[at] = True
+        seq[mask] = Q
+        seq[~mask] = inner
+        self.checks += len(seq)
+        return not self._any_collides(seq)
 
 
 class _MotionValidator(ob.MotionValidator):

@@ -224,10 +224,21 @@ class Arm:
         arr = np.asarray(Q, dtype=float).reshape(-1, self.nq)
         if not np.all(np.isfinite(arr)):
             raise JointVectorError(Q, 6)
+        return self._batch_checker().each(arr)
+
+    def in_collision_any(self, Q: ArrayLike) -> bool:
+        """True when a row of ``Q`` (N, 6) rad is in collision (:meth:`in_collision`), checked
+        in row order up to the first hit, in one batch call."""
+        arr = np.asarray(Q, dtype=float).reshape(-1, self.nq)
+        if not np.all(np.isfinite(arr)):
+            raise JointVectorError(Q, 6)
+        return bool(self._batch_checker().any_hit([arr.T])[0])
+
+    def _batch_checker(self) -> BatchCollision:
         collision = self.collision
         if self._batch is None or self._batch[0] is not collision:
             self._batch = (collision, BatchCollision(collision))
-        return self._batch[1].each(arr)
+        return self._batch[1]
 
     def colliding_pairs(self, q: ArrayLike) -> list[tuple[str, str]]:
         """Names of the geometry pairs in contact at ``q``."""

@@ -47,8 +47,8 @@ def test_blocked_motions_cost_their_shortest_detour_through_free_ones() -> None:
 
 
 def test_concatenated_linspaces_equal_numpy_linspace_bit_for_bit() -> None:
-    from planner.edge_check import _linspaces
+    from planner.sampling import linspaces
 
     n = np.array([1, 2, 3, 7, 10, 33, 129])
     want = np.concatenate([np.linspace(0.0, 1.0, m + 1) for m in n])
-    assert np.array_equal(_linspaces(n), want)
+    assert np.array_equal(linspaces(n), want)
