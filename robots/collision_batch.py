@@ -20,9 +20,12 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 #: batches of fewer configurations than this run on one thread: OpenMP's start and its
-#: spinning workers cost more CPU than a small batch saves (measured on cluttered-80: 60
-#: batches of 8 motions, 0.7-0.8 s CPU on one thread, 1.5 s on two)
-PARALLEL_MIN_CONFIGS = 5000
+#: spinning workers cost more CPU than a small batch saves (measured on cluttered-80 at
+#: load 3.3-3.6: batches of 2000-50 000 configurations, 5-20 % more CPU on two threads and
+#: no shorter wall time; 60 lazy-round batches of 8 motions: 0.7-0.8 s CPU on one thread,
+#: 1.5 s on two). Large batches (a roadmap, ~10^5 configurations) still use every core: on an
+#: idle machine, with nothing else running, that is where two threads can halve the wall.
+PARALLEL_MIN_CONFIGS = 20000
 
 
 def default_threads() -> int:
