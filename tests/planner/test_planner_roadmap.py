@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -61,7 +63,7 @@ def test_polyline_in_one_batch_equals_segment_by_segment_one_configuration_at_a_
     def reference(P: np.ndarray) -> bool:  # every row and every segment's samples, one by one
         if not all(arm.within_limits(q) and not arm.in_collision(q) for q in P):
             return False
-        for a, b in zip(P[:-1], P[1:], strict=True):
+        for a, b in itertools.pairwise(P):
             Q = checker.samples(a, b)
             if not checker._inside(Q) or any(arm.in_collision(q) for q in Q[1:-1]):
                 return False
