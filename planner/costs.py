@@ -80,6 +80,10 @@ def cost_matrix(
     return out
 
 
+#: rows per block of a symmetric :meth:`CostTable.matrix`
+SYMMETRIC_BLOCK = 256
+
+
 class CostTable:
     """Fast approximate travel-time matrices from per-joint lookup tables.
 
@@ -108,9 +112,25 @@ class CostTable:
             self.tables.append(rest_to_rest_time(grid, v[k], a[k], j[k]).astype(np.float32))
 
     def matrix(self, q_rows: ArrayLike, q_cols: ArrayLike) -> NDArray[np.float32]:
-        """Approximate :func:`cost_matrix` (s, float32) between the rows of two arrays (rad)."""
+        """Approximate :func:`cost_matrix` (s, float32) between the rows of two arrays (rad).
+
+        When ``q_cols`` is ``q_rows`` (the same object) the matrix is symmetric (the table's
+        argument is ``|a - b|``, exactly the same both ways in floating point): the upper
+        triangle is computed in blocks of rows and mirrored, about half the work.
+        """
         rows = np.atleast_2d(np.asarray(q_rows, dtype=float))
-        cols = np.atleast_2d(np.asarray(q_cols, dtype=float))
+        if q_cols is not q_rows:
+            return self._block(rows, np.atleast_2d(np.asarray(q_cols, dtype=float)))
+        n = rows.shape[0]
+        out = np.zeros((n, n), dtype=np.float32)
+        for i0 in range(0, n, SYMMETRIC_BLOCK):
+            i1 = min(i0 + SYMMETRIC_BLOCK, n)
+            block = self._block(rows[i0:i1], rows[i0:])
+            out[i0:i1, i0:] = block
+            out[i0:, i0:i1] = block.T
+        return out
+
+    def _block(self, rows: NDArray[np.float64], cols: NDArray[np.float64]) -> NDArray[np.float32]:
         out = np.zeros((rows.shape[0], cols.shape[0]), dtype=np.float32)
         delta = np.empty_like(out)
         idx = np.empty(out.shape, dtype=np.int32)

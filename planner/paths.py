@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,6 +28,7 @@ from ompl import util as ou
 
 from planner.errors import SegmentPlanningError
 from planner.protocols import ArmLike
+from planner.sampling import interior_samples, motion_counts, tcp_positions
 
 log = logging.getLogger(__name__)
 
@@ -45,7 +47,14 @@ def seed_ompl(seed: int) -> None:
 
 
 def _interpolation_order(n: int) -> NDArray[np.int64]:
-    """Indices 1..n-1 coarse to fine (a van der Corput order), so collisions show early."""
+    """Indices 1..n-1 coarse to fine (a van der Corput order), so collisions show early.
+
+    Cached per ``n`` (read-only arrays: many motions share a sample count)."""
+    return _order_of(int(n))
+
+
+@lru_cache(maxsize=4096)
+def _order_of(n: int) -> NDArray[np.int64]:
     order, seen = [], set()
     step = 1 << max(int(np.ceil(np.log2(max(n, 2)))), 1)
     while step >= 1:
@@ -54,7 +63,9 @@ def _interpolation_order(n: int) -> NDArray[np.int64]:
                 seen.add(i)
                 order.append(i)
         step //= 2
-    return np.array(order, dtype=np.int64)
+    out = np.array(order, dtype=np.int64)
+    out.flags.writeable = False
+    return out
 
 
 class MotionChecker:
@@ -89,7 +100,7 @@ class MotionChecker:
         for _ in range(8):
             t = np.linspace(0.0, 1.0, n + 1)[:, None]
             Q = q_a + t * (q_b - q_a)
-            tcp = self.arm.fk_dh(Q, "tcp")[:, :3, 3]
+            tcp = tcp_positions(self.arm, Q)
             worst = np.linalg.norm(np.diff(tcp, axis=0), axis=1).max()
             if worst <= self.tcp_step:
                 return Q
@@ -107,16 +118,43 @@ class MotionChecker:
             return False
         order = _interpolation_order(len(Q) - 1)
         self.checks += len(order)
-        return not any(self.arm.in_collision(Q[i]) for i in order)
+        return not self._any_collides(Q[order])
+
+    def _any_collides(self, Q: NDArray[np.float64]) -> bool:
+        """True when a row of ``Q`` collides, checked in row order up to the first hit: one
+        batch call where the arm offers it (``robots.Arm.in_collision_any``), else one by one.
+        """
+        batch = getattr(self.arm, "in_collision_any", None)
+        if batch is not None:
+            return bool(batch(Q))
+        return any(self.arm.in_collision(q) for q in Q)
 
     def polyline_free(self, Q: NDArray[np.float64]) -> bool:
-        """True when the motion through the rows of ``Q`` (straight between rows) is free."""
-        if not self.state_free(Q[0]):
+        """True when the motion through the rows of ``Q`` (straight between rows) is free.
+
+        The rows and every segment's samples within the limits, and none colliding; checked
+        in the order row 0, segment 1 coarse to fine, row 1, segment 2, ... (all segments'
+        samples made at once, :mod:`planner.sampling`; the same samples and answer as checking
+        one segment at a time).
+        """
+        Q = np.asarray(Q, dtype=float)
+        if len(Q) < 2:
+            return self.state_free(Q[0])
+        A, B = Q[:-1], Q[1:]
+        n = motion_counts(self.arm, self.joint_step, self.tcp_step, A, B)
+        inner, bounds = interior_samples(A, B, n, _interpolation_order)
+        last = A + 1.0 * (B - A)  # each segment's last sample (np.linspace's)
+        if not (self._inside(Q) and self._inside(inner) and self._inside(last)):
             return False
-        return all(
-            self.segment_free(Q[i], Q[i + 1]) and self.state_free(Q[i + 1])
-            for i in range(len(Q) - 1)
-        )
+        # row i goes before segment i's samples: its position is i + the samples before it
+        at = np.arange(len(Q)) + bounds
+        seq = np.empty((len(Q) + len(inner), Q.shape[1]))
+        mask = np.zeros(len(seq), dtype=bool)
+        mask[at] = True
+        seq[mask] = Q
+        seq[~mask] = inner
+        self.checks += len(seq)
+        return not self._any_collides(seq)
 
 
 class _MotionValidator(ob.MotionValidator):
@@ -220,13 +258,15 @@ class SegmentPlanner:
         time_s: float,
         names: tuple[str, str],
         via: NDArray[np.float64] | None = None,
+        straight_free: bool = False,
     ) -> SegmentPath:
         """A free path ``q_a`` to ``q_b``, else :class:`SegmentPlanningError` naming ``names``.
 
         ``via`` (rows, rad): a detour through known free configurations, tried (validated at
         the set resolution, shortcut where straight motions are free) before OMPL.
+        ``straight_free``: the caller checked the straight motion at the set resolution.
         """
-        if self.checker.segment_free(q_a, q_b):
+        if straight_free or self.checker.segment_free(q_a, q_b):
             return SegmentPath(np.array([q_a, q_b]), planned=False)
         if via is not None and len(via):
             Q = np.vstack([q_a, via, q_b])

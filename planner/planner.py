@@ -185,11 +185,15 @@ class TourPlanner(LazyEdgeChecks):
         out = []
         for k in range(len(points) - 1):
             via = None
+            known = False  # checked free at the set resolution by the lazy rounds' batch
             if path is not None:
                 hops = self._roadmap.via(path[k], path[k + 1])
                 via = None if not hops else seqr.nodes[hops]
+                u, v = path[k], path[k + 1]
+                known = self._edge_free.get((min(u, v), max(u, v))) is True
             try:
-                out.append(cache.get(points[k], points[k + 1], (names[k], names[k + 1]), via))
+                pair = (names[k], names[k + 1])
+                out.append(cache.get(points[k], points[k + 1], pair, via, known))
             except SegmentPlanningError as exc:
                 exc.nodes = None if path is None else (path[k], path[k + 1])
                 raise

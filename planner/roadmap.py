@@ -38,6 +38,26 @@ class Roadmap:
     free: dict[tuple[int, int], bool] = field(default_factory=dict)
     detours: dict[tuple[int, int], list[int]] = field(default_factory=dict)
     checked: int = 0
+    #: the free motions as index arrays, made on the first detour query: (entries, u, v)
+    _edges: tuple[int, NDArray[np.int64], NDArray[np.int64]] | None = field(
+        default=None, repr=False, compare=False
+    )
+
+    def graph(self, G: NDArray[np.float64]) -> csr_matrix | None:
+        """The free motions as a sparse graph weighted by the current ``G`` (s), or None.
+
+        The free motions' index arrays are made once (``free`` is filled once by
+        :func:`build_roadmap`; made again if its number of entries changed); the weights are
+        read from ``G`` at each call (learned costs change it).
+        """
+        if self._edges is None or self._edges[0] != len(self.free):
+            e = np.array([uv for uv, f in self.free.items() if f], dtype=np.int64).reshape(-1, 2)
+            self._edges = (len(self.free), e[:, 0], e[:, 1])
+        _, u, v = self._edges
+        if not len(u):
+            return None
+        N = G.shape[0]
+        return csr_matrix((np.maximum(G[u, v], 1e-9), (u, v)), shape=(N, N))
 
     def via(self, u: int, v: int) -> list[int] | None:
         """Intermediate nodes of the roadmap detour from ``u`` to ``v`` (None: none known)."""
@@ -89,15 +109,11 @@ def detour_costs(
     """
     if not blocked:
         return {}
-    N = G.shape[0]
-    free = [(u, v) for (u, v), f in rm.free.items() if f]
     out: dict[tuple[int, int], float] = {}
     sources = sorted({u for u, _ in blocked})
     dist = pred = None
-    if free:
-        e = np.array(free)
-        w = np.maximum(G[e[:, 0], e[:, 1]], 1e-9)
-        graph = csr_matrix((w, (e[:, 0], e[:, 1])), shape=(N, N))
+    graph = rm.graph(G)
+    if graph is not None:
         dist, pred = dijkstra(graph, directed=False, indices=sources, return_predecessors=True)
     row = {s: i for i, s in enumerate(sources)}
     for u, v in blocked:

@@ -61,16 +61,20 @@ class SegmentCache:
         q_b: NDArray[np.float64],
         names: tuple[str, str],
         via: NDArray[np.float64] | None = None,
+        straight_free: bool = False,
     ) -> Segment:
         """The segment ``q_a`` to ``q_b`` (rad); :class:`SegmentPlanningError` if unsolvable.
 
         ``via``: intermediate configurations of a roadmap detour, tried before OMPL.
+        ``straight_free``: the straight motion is known free at the set resolution (a batch
+        check of the same samples, :class:`planner.edge_check.BatchEdgeChecker`): not
+        checked again.
         """
 
         key = np.concatenate([q_a, q_b]).tobytes()
         if key not in self.cache:
             t = time.perf_counter()
-            path = self.planner.plan(q_a, q_b, self.segment_time_s, names, via)
+            path = self.planner.plan(q_a, q_b, self.segment_time_s, names, via, straight_free)
             self.path_time_s += time.perf_counter() - t
             t = time.perf_counter()
             self.cache[key] = Segment(path, self._time(path))

@@ -7,7 +7,7 @@ inward normal (TCP z = -normal); an optional tilt cone adds directions at
 ``roll_step_deg``. For each pose, every IK solution within the joint limits
 (every branch, every J4/J6 value 2*pi apart) that is free of collision is a
 candidate. Collision is checked once per distinct arm geometry (values 2*pi
-apart put the arm in the same place).
+apart put the arm in the same place), all of a hole's in one batch call.
 """
 
 from __future__ import annotations
@@ -101,6 +101,15 @@ def _describe_collisions(arm: ArmLike, samples: list[NDArray[np.float64]]) -> st
     return f"in collision from every viewpoint (e.g. {a} with {b})"
 
 
+def _in_collision_each(arm: ArmLike, Q: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """``arm.in_collision`` of each row of ``Q``: one batch call where the arm offers it
+    (``robots.Arm.in_collision_each``, the same answers), else one at a time."""
+    each = getattr(arm, "in_collision_each", None)
+    if each is not None:
+        return np.asarray(each(Q), dtype=bool).reshape(len(Q))
+    return np.array([arm.in_collision(q) for q in Q], dtype=bool)
+
+
 def hole_candidates(
     arm: ArmLike,
     hole: HoleLike,
@@ -117,6 +126,7 @@ def hole_candidates(
     ik_reasons: Counter[str] = Counter()
     colliding: list[NDArray[np.float64]] = []
     n_solutions = 0
+    solved = []  # (pose, IK result, first row of each distinct arm geometry, inverse)
     for p, T in enumerate(poses):
         result = arm.ik(T)
         if not result.ok:
@@ -125,8 +135,13 @@ def hole_candidates(
         n_solutions += len(result.solutions)
         wrapped = np.round((result.solutions + np.pi) % (2 * np.pi) - np.pi, 9)
         _, first, inverse = np.unique(wrapped, axis=0, return_index=True, return_inverse=True)
-        free = np.array([not arm.in_collision(result.solutions[i]) for i in first])
-        keep = free[inverse.ravel()]
+        solved.append((p, result, first, inverse.ravel()))
+    distinct = [result.solutions[first] for _, result, first, _ in solved]
+    hit = _in_collision_each(arm, np.vstack(distinct) if distinct else np.zeros((0, 6)))
+    offsets = np.cumsum([0] + [len(d) for d in distinct])
+    for (p, result, first, inverse), lo in zip(solved, offsets[:-1], strict=True):
+        free = ~hit[lo : lo + len(first)]
+        keep = free[inverse]
         if not free.all():
             colliding.extend(result.solutions[i] for i in first[~free])
         qs.append(result.solutions[keep])

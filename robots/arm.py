@@ -17,7 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from robots.arm_kinematics import check_given_table, derive_kinematics
 from robots.collision import Clearance, CollisionModel
-from robots.dh import DHTable, fk_dh
+from robots.collision_batch import BatchCollision
+from robots.dh import DHTable, fk_dh, point_dh
 from robots.errors import JointVectorError, UnknownModelError, UrdfError
 from robots.ik import IKResult, solve_opw
 from robots.limits import narrowed_limits
@@ -120,6 +121,7 @@ class Arm:
         self._frame_ids = {"tool0": self.model.getFrameId("tool0")}
         self._T_tool0_flange = self.loaded.T_tool0_flange
         self._collision: CollisionModel | None = None
+        self._batch: tuple[CollisionModel, BatchCollision] | None = None
         self.clearance_margins = Clearance()
 
     @property
@@ -195,6 +197,17 @@ class Arm:
             return T @ self.T_tool0_tcp
         return T @ self._T_tool0_flange if frame == "flange" else T
 
+    def tcp_positions(self, q: ArrayLike) -> Array:
+        """TCP positions (N, 3) in the cell frame (m) for configurations ``q`` (N, 6) rad.
+
+        Equal to ``fk_dh(q, "tcp")[:, :3, 3]`` (to rounding); faster where only positions are
+        needed (the TCP-step rule of motion checks samples many configurations).
+        """
+        if self._dh is None:
+            return self.fk_dh(q, "tcp")[..., :3, 3]
+        p_base = point_dh(self._dh, q, self.T_tool0_tcp[:3, 3])
+        return p_base @ self.T_cell_base[:3, :3].T + self.T_cell_base[:3, 3]
+
     def ik(self, T_cell_tcp: ArrayLike) -> IKResult:
         """Every joint solution placing the TCP at ``T_cell_tcp`` (see :mod:`robots.ik`)."""
         T_base_tool0 = self._T_base_cell @ np.asarray(T_cell_tcp, float) @ self._T_tcp_tool0
@@ -204,6 +217,28 @@ class Arm:
     def in_collision(self, q: ArrayLike) -> bool:
         """True when the arm touches itself (non-adjacent links) or touches an obstacle."""
         return self.collision.in_collision(self.check_q(q))
+
+    def in_collision_each(self, Q: ArrayLike) -> NDArray[np.bool_]:
+        """:meth:`in_collision` of each row of ``Q`` (N, 6) rad, in one batch call (the same
+        answers; :class:`robots.collision_batch.BatchCollision`)."""
+        arr = np.asarray(Q, dtype=float).reshape(-1, self.nq)
+        if not np.all(np.isfinite(arr)):
+            raise JointVectorError(Q, 6)
+        return self._batch_checker().each(arr)
+
+    def in_collision_any(self, Q: ArrayLike) -> bool:
+        """True when a row of ``Q`` (N, 6) rad is in collision (:meth:`in_collision`), checked
+        in row order up to the first hit, in one batch call."""
+        arr = np.asarray(Q, dtype=float).reshape(-1, self.nq)
+        if not np.all(np.isfinite(arr)):
+            raise JointVectorError(Q, 6)
+        return bool(self._batch_checker().any_hit([arr.T])[0])
+
+    def _batch_checker(self) -> BatchCollision:
+        collision = self.collision
+        if self._batch is None or self._batch[0] is not collision:
+            self._batch = (collision, BatchCollision(collision))
+        return self._batch[1]
 
     def colliding_pairs(self, q: ArrayLike) -> list[tuple[str, str]]:
         """Names of the geometry pairs in contact at ``q``."""

@@ -153,6 +153,25 @@ def fk_dh(table: DHTable, q: ArrayLike) -> Array:
     return chain(link_transforms(table, q))
 
 
+def point_dh(table: DHTable, q: ArrayLike, p_tool0: ArrayLike) -> Array:
+    """Position (..., 3) in ``base_link`` of the point ``p_tool0`` (3,) fixed in ``tool0`` (m).
+
+    The same value as ``(fk_dh(table, q) @ [*p_tool0, 1])[..., :3]`` (to rounding), about ten
+    times faster for many configurations: the point is carried through the links from the
+    last to the first (a handful of array operations per link, no 4x4 products).
+    """
+    a, offset, ca, sa, rows = _constant_rows(table)
+    d = rows[:, 0, 3]
+    theta = np.asarray(table.joint_values(q), dtype=float) + offset
+    ct, st = np.cos(theta), np.sin(theta)
+    x, y, z = (np.full(theta.shape[:-1], float(c)) for c in np.asarray(p_tool0, dtype=float))
+    for i in range(5, -1, -1):  # p_{i-1} = Rz(theta) Tz(d) Tx(a) Rx(alpha) p_i
+        y, z = ca[i] * y - sa[i] * z, sa[i] * y + ca[i] * z + d[i]
+        x = x + a[i]
+        x, y = ct[..., i] * x - st[..., i] * y, st[..., i] * x + ct[..., i] * y
+    return np.stack([x, y, z], axis=-1)
+
+
 def fk_dh_arrays(
     a: ArrayLike, d: ArrayLike, alpha: ArrayLike, theta_offset: ArrayLike, q: ArrayLike
 ) -> Array:

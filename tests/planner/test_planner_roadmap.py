@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -44,3 +46,36 @@ def test_blocked_motions_cost_their_shortest_detour_through_free_ones() -> None:
     # node 4 is not on the roadmap: the estimate
     assert costs[(1, 4)] == pytest.approx(DETOUR_FACTOR * 8.0 + DETOUR_EXTRA_S)
     assert rm.via(1, 4) is None
+
+
+def test_concatenated_linspaces_equal_numpy_linspace_bit_for_bit() -> None:
+    from planner.sampling import linspaces
+
+    n = np.array([1, 2, 3, 7, 10, 33, 129])
+    want = np.concatenate([np.linspace(0.0, 1.0, m + 1) for m in n])
+    assert np.array_equal(linspaces(n), want)
+
+
+def test_polyline_in_one_batch_equals_segment_by_segment_one_configuration_at_a_time(arm) -> None:
+    checker = MotionChecker(arm, np.radians(1.5), 0.006)
+    rng = np.random.default_rng(4)
+
+    def reference(P: np.ndarray) -> bool:  # every row and every segment's samples, one by one
+        if not all(arm.within_limits(q) and not arm.in_collision(q) for q in P):
+            return False
+        for a, b in itertools.pairwise(P):
+            Q = checker.samples(a, b)
+            if not checker._inside(Q) or any(arm.in_collision(q) for q in Q[1:-1]):
+                return False
+        return True
+
+    got, want = [], []
+    for _ in range(40):
+        P = [rng.uniform(arm.lower, arm.upper) * 0.4]
+        for _ in range(rng.integers(1, 5)):
+            P.append(P[-1] + rng.normal(scale=0.25, size=6))
+        P = np.array(P)
+        got.append(checker.polyline_free(P))
+        want.append(reference(P))
+    assert got == want
+    assert 0 < sum(got) < len(got)  # both answers occur
