@@ -73,7 +73,9 @@ def _usable(
 
 def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour, HoleRegion]:
     region = hole_region(img, full, cand)
-    edges = subpixel_edges(img, full, region, opts.edge_method, opts.smoothing_sigma_px)
+    edges = subpixel_edges(
+        img, full, region, opts.edge_method, opts.smoothing_sigma_px, opts.slope_correction
+    )
     pts = edges.points_px
     blur = edges.blur_sigma_px if opts.curvature_correction else 0.0
     contour = build_contour(
