@@ -62,7 +62,9 @@ class HoleCandidate:
     ``polarity`` is ``"dark"`` (hole darker than the surface) or ``"bright"``;
     ``levels`` is how many ladder levels gave this region (its plateau length);
     ``alternates`` the same hole's regions at the other levels (another run of levels),
-    which the left/right cross-check may prefer when their sizes agree better.
+    which the left/right cross-check may prefer when their sizes agree better;
+    ``surface_level`` the surface's gray level around a bright hole (fraction of full
+    scale; set by :func:`measure.opening.with_wall_crescent`, ``None`` otherwise).
     """
 
     centroid_px: tuple[float, float]
@@ -73,6 +75,7 @@ class HoleCandidate:
     touches_border: bool
     levels: int = 1
     alternates: tuple[HoleCandidate, ...] = ()
+    surface_level: float | None = None
 
 
 def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray | None:

@@ -126,7 +126,14 @@ def hole_region(
     box = (x0, y0, x1 - x0, y1 - y0)
     dark = cand.polarity == "dark"
     level = cand.threshold
-    region = _region((roi_img <= level * full) if dark else (roi_img > level * full), seed)
+    surf = cand.surface_level
+    if dark:
+        first = roi_img <= level * full
+    elif surf is None or level <= surf:
+        first = roi_img > level * full
+    else:  # the lit background and the wall crescent beside it (measure.opening)
+        first = (roi_img > level * full) | (roi_img < (2 * surf - level) * full)
+    region = _region(first, seed)
     inside = outside = level
     dist = None
     if region.any():
@@ -134,7 +141,10 @@ def hole_region(
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
         core = cv2.erode(region, ker) > 0
         dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)  # px outside the region
-        lin, lout = _median(roi_img, core, full), _median(roi_img, _ring(dist, 3, 3 + k), full)
+        lout = _median(roi_img, _ring(dist, 3, 3 + k), full)
+        if not dark and lout is not None:  # the lit part only, not the wall crescent
+            core &= roi_img > lout * full
+        lin = _median(roi_img, core, full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)

@@ -26,6 +26,7 @@ from measure.errors import (
 )
 from measure.match import match_contours
 from measure.nearside import fit_with_near_side_check
+from measure.opening import with_wall_crescent
 from measure.pairing import pick_pair
 from measure.result import HoleMeasurement, MeasureOptions, RimChoice
 from measure.triangulate import triangulate
@@ -223,6 +224,8 @@ def measure_hole(
     st_l, st_r = {}, {}
     cand_l = _usable(find_candidates(small_l, roi_l, stats=st_l), "left", roi_l, left.shape, st_l)
     cand_r = _usable(find_candidates(small_r, roi_r, stats=st_r), "right", roi_r, right.shape, st_r)
+    cand_l = [with_wall_crescent(small_l, c) for c in cand_l]  # a lit background's lens
+    cand_r = [with_wall_crescent(small_r, c) for c in cand_r]  # → the whole opening
     cl, cr, check = pick_pair(
         cand_l, cand_r, stereo, expected_diameter_m, opts.size_tolerance, expected_standoff_m
     )
