@@ -13,8 +13,9 @@ with g the Gaussian of the total blur σ, Φ its integral, A the step and s₊, 
 slopes (gradient along the same direction) on the bright and the dark side. Setting
 I''(x) = 0 gives the maximum at x* = (s₊ − s₋) σ² / A: it leans toward the side whose
 slope has the step's sign. With A = √(2π) σ I'(0) and the slope read off the gradient
-image 3σ from the point (where the step's own gradient has fallen to 1 %), each point is
-moved back by x* along its gradient direction.
+image 3σ from the point, less the step's own Gaussian tail there (I'(0) e^(−9/2), 1.1 %
+of the peak, which would otherwise read as a slope and move every point outward by
+0.004 σ), each point is moved back by x* along its gradient direction.
 
 Only the *inside* slope is read (s₋ for a dark hole, s₊ for a lit background seen
 through it); the outside one is taken as zero. Outside the rim is the part's surface,
@@ -99,6 +100,7 @@ def slope_shift(
     side = np.where(inward, 1.0, -1.0)  # +1: the gradient points into the hole
     q = points_px + (side * SLOPE_OFFSET_SIGMA * sigma_px)[:, None] * normals
     s_inside = _sample(gx, q) * normals[:, 0] + _sample(gy, q) * normals[:, 1]
+    s_inside -= peak * np.exp(-0.5 * SLOPE_OFFSET_SIGMA**2)  # the step's own Gaussian tail
     s_plus = np.where(inward, s_inside, 0.0)
     s_minus = np.where(inward, 0.0, s_inside)
     with np.errstate(divide="ignore", invalid="ignore"):
