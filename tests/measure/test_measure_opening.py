@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 from measure_helpers import angle_deg, render, small_stereo
 
@@ -42,3 +43,14 @@ def test_a_dark_hole_is_left_as_it_is():
     cand = find_candidates(small)[0]
     assert cand.polarity == "dark"
     assert with_wall_crescent(small, cand) == cand
+
+
+def test_a_dark_blob_in_one_image_does_not_hide_a_lit_background():
+    """Dark discs come before bright ones; a dark stain in one image only (no partner in
+    the other) must not refuse the lit background's opening that both images show."""
+    r = render(0.010, 15.0, 1, LIT)
+    left = r.left.copy()
+    cv2.circle(left, (60, 60), 20, 20, thickness=-1)  # a dark stain, left image only
+    m = measure_hole(left, r.right, small_stereo(), expected_diameter_m=0.010)
+    assert m.rim.polarity == "bright"
+    assert abs(m.radius_m - r.truth.edge_radius_m) < 5e-6
