@@ -62,7 +62,9 @@ class HoleCandidate:
     ``polarity`` is ``"dark"`` (hole darker than the surface) or ``"bright"``;
     ``levels`` is how many ladder levels gave this region (its plateau length);
     ``alternates`` the same hole's regions at the other levels (another run of levels),
-    which the left/right cross-check may prefer when their sizes agree better.
+    which the left/right cross-check may prefer when their sizes agree better;
+    ``surface_level`` the surface's gray level around a bright hole (fraction of full
+    scale; set by :func:`measure.opening.with_wall_crescent`, ``None`` otherwise).
     """
 
     centroid_px: tuple[float, float]
@@ -73,6 +75,7 @@ class HoleCandidate:
     touches_border: bool
     levels: int = 1
     alternates: tuple[HoleCandidate, ...] = ()
+    surface_level: float | None = None
 
 
 def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray | None:
@@ -287,6 +290,7 @@ def find_candidates(
     roi: tuple[int, int, int, int] | None = None,
     min_diameter_px: float = 16.0,
     stats: dict | None = None,
+    others: list[HoleCandidate] | None = None,
 ) -> list[HoleCandidate]:
     """Disc-like dark regions (else bright ones) in the search image (optionally in ``roi``).
 
@@ -294,6 +298,8 @@ def find_candidates(
     coordinates are full-resolution pixels. ``stats``, when given, receives what decided:
     ``contrast`` per class (fraction of full scale from the extreme to the median; a class
     is searched from 0.2) and ``regions`` (compact regions that got the disc test).
+    ``others``, when given, receives the other polarity's holes that hold over two or
+    more levels (the left/right check's fallback when the returned ones find no partner).
     """
     ox, oy = 0, 0
     s = SEARCH_SCALE
@@ -332,6 +338,9 @@ def find_candidates(
     order += [(p, t, hs) for p, (t, hs) in found.items()]
     for polarity, thresholds, holes in order:
         if holes:
+            if others is not None:
+                others += [_candidate(h, p, t, (ox, oy)) for p, (t, hs) in found.items()
+                           if p != polarity for h in hs if h[8] >= 2]  # fmt: skip
             return [_candidate(h, polarity, thresholds, (ox, oy)) for h in holes]
     return []
 

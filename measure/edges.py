@@ -21,6 +21,7 @@ import cv2
 import numpy as np
 
 from measure.detect import HoleCandidate, without_bites
+from measure.slope import slope_shift
 
 EDGE_METHODS = ("parabola", "linear")
 
@@ -125,7 +126,14 @@ def hole_region(
     box = (x0, y0, x1 - x0, y1 - y0)
     dark = cand.polarity == "dark"
     level = cand.threshold
-    region = _region((roi_img <= level * full) if dark else (roi_img > level * full), seed)
+    surf = cand.surface_level
+    if dark:
+        first = roi_img <= level * full
+    elif surf is None or level <= surf:
+        first = roi_img > level * full
+    else:  # the lit background and the wall crescent beside it (measure.opening)
+        first = (roi_img > level * full) | (roi_img < (2 * surf - level) * full)
+    region = _region(first, seed)
     inside = outside = level
     dist = None
     if region.any():
@@ -133,7 +141,10 @@ def hole_region(
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
         core = cv2.erode(region, ker) > 0
         dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)  # px outside the region
-        lin, lout = _median(roi_img, core, full), _median(roi_img, _ring(dist, 3, 3 + k), full)
+        lout = _median(roi_img, _ring(dist, 3, 3 + k), full)
+        if not dark and lout is not None:  # the lit part only, not the wall crescent
+            core &= roi_img > lout * full
+        lin = _median(roi_img, core, full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
@@ -178,8 +189,13 @@ def subpixel_edges(
     region: HoleRegion,
     method: str = "parabola",
     sigma_px: float = 1.0,
+    slope_correction: bool = False,
 ) -> EdgePoints:
-    """Canny edge pixels near the hole outline, refined to sub-pixel points."""
+    """Canny edge pixels near the hole outline, refined to sub-pixel points.
+
+    With ``slope_correction`` (``"parabola"`` only) each gradient maximum is moved back by
+    the shift a brightness slope beside the edge causes (:mod:`measure.slope`).
+    """
     if method not in EDGE_METHODS:
         raise ValueError(f"edge method must be one of {EDGE_METHODS}, got {method!r}")
     x0, y0, w, h = region.roi
@@ -208,13 +224,21 @@ def subpixel_edges(
         off, ok = _parabola(mag, xs, ys, sx, sy)
     else:
         off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
-    pts = np.stack([xs + off * sx + x0, ys + off * sy + y0], axis=1)[ok]
-    widths = _edge_widths(mag, gx, gy, xs[ok], ys[ok], sx[ok], sy[ok])
+    pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
+    xs, ys = xs[ok], ys[ok]
+    widths = _edge_widths(mag, gx, gy, xs, ys, sx[ok], sy[ok])
     finite = widths[np.isfinite(widths)]
+    blur = float(np.median(finite)) if len(finite) else 0.0
+    strength = mag[ys, xs].astype(np.float64)
+    if slope_correction and method == "parabola" and len(pts):
+        normals = np.stack([gx[ys, xs], gy[ys, xs]], axis=1) / np.maximum(strength, 1e-12)[:, None]
+        centre = (region.centroid_px[0] - x0, region.centroid_px[1] - y0)
+        shift = slope_shift(gx, gy, pts, normals, strength, blur, centre)
+        pts -= shift[:, None] * normals
     return EdgePoints(
-        points_px=pts.astype(np.float64),
-        strength=mag[ys, xs][ok].astype(np.float64),
-        blur_sigma_px=float(np.median(finite)) if len(finite) else 0.0,
+        points_px=pts + np.array([x0, y0], dtype=np.float64),
+        strength=strength,
+        blur_sigma_px=blur,
         width_px=widths,
     )
 

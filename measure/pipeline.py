@@ -18,14 +18,17 @@ from measure.contour import Contour, build_contour
 from measure.detect import SEARCH_SCALE, HoleCandidate, check_image, find_candidates, to_gray
 from measure.edges import HoleRegion, hole_region, subpixel_edges
 from measure.errors import (
+    AmbiguousHoleError,
     EdgeError,
     HoleAtBorderError,
     HoleNotFoundError,
     HoleSizeError,
     ImageError,
+    StereoMismatchError,
 )
 from measure.match import match_contours
 from measure.nearside import fit_with_near_side_check
+from measure.opening import with_wall_crescent
 from measure.pairing import pick_pair
 from measure.result import HoleMeasurement, MeasureOptions, RimChoice
 from measure.triangulate import triangulate
@@ -73,7 +76,9 @@ def _usable(
 
 def _contour(img, full, cand, opts: MeasureOptions, which: str) -> tuple[Contour, HoleRegion]:
     region = hole_region(img, full, cand)
-    edges = subpixel_edges(img, full, region, opts.edge_method, opts.smoothing_sigma_px)
+    edges = subpixel_edges(
+        img, full, region, opts.edge_method, opts.smoothing_sigma_px, opts.slope_correction
+    )
     pts = edges.points_px
     blur = edges.blur_sigma_px if opts.curvature_correction else 0.0
     contour = build_contour(
@@ -170,6 +175,30 @@ def _suspect_reasons(
     return tuple(out)
 
 
+def _pick(cand_l, cand_r, oth_l, oth_r, pair_args):
+    """The left/right pair (:func:`measure.pairing.pick_pair`); when none of the returned
+    candidates pair, each polarity is tried once more with the other polarity's holes
+    (a dark texture blob in a dim corner taken for the hole in one image, while both show
+    a lit background's opening), and a pair of exactly one polarity is taken."""
+    try:
+        return pick_pair(cand_l, cand_r, *pair_args)
+    except StereoMismatchError as first:
+        found = []
+        for pol in ("dark", "bright"):
+            a = [c for c in cand_l + oth_l if c.polarity == pol and not c.touches_border]
+            b = [c for c in cand_r + oth_r if c.polarity == pol and not c.touches_border]
+            tried = all(c in cand_l for c in a) and all(c in cand_r for c in b)
+            if not a or not b or tried:
+                continue
+            try:
+                found.append(pick_pair(a, b, *pair_args))
+            except (StereoMismatchError, AmbiguousHoleError):
+                continue
+        if len(found) != 1:
+            raise first from None
+        return found[0]
+
+
 def _weights(c: Contour, opts: MeasureOptions) -> np.ndarray:
     w = np.ones(len(c.points_px))
     if not opts.use_long_fills:
@@ -218,12 +247,16 @@ def measure_hole(
     full_r, small_r = check_image(right, "right")
     stereo.check_image(left.shape, "left")
     roi_l, roi_r = _rois(roi)
-    st_l, st_r = {}, {}
-    cand_l = _usable(find_candidates(small_l, roi_l, stats=st_l), "left", roi_l, left.shape, st_l)
-    cand_r = _usable(find_candidates(small_r, roi_r, stats=st_r), "right", roi_r, right.shape, st_r)
-    cl, cr, check = pick_pair(
-        cand_l, cand_r, stereo, expected_diameter_m, opts.size_tolerance, expected_standoff_m
-    )
+    st_l, st_r, oth_l, oth_r = {}, {}, [], []
+    found_l = find_candidates(small_l, roi_l, stats=st_l, others=oth_l)
+    found_r = find_candidates(small_r, roi_r, stats=st_r, others=oth_r)
+    cand_l = _usable(found_l, "left", roi_l, left.shape, st_l)
+    cand_r = _usable(found_r, "right", roi_r, right.shape, st_r)
+    # a lit background's lens → the whole opening (measure.opening)
+    cand_l, oth_l = ([with_wall_crescent(small_l, c) for c in cs] for cs in (cand_l, oth_l))
+    cand_r, oth_r = ([with_wall_crescent(small_r, c) for c in cs] for cs in (cand_r, oth_r))
+    pair_args = (stereo, expected_diameter_m, opts.size_tolerance, expected_standoff_m)
+    cl, cr, check = _pick(cand_l, cand_r, oth_l, oth_r, pair_args)
     t["detect"] = time.perf_counter() - t0
 
     t1 = time.perf_counter()

@@ -21,6 +21,9 @@ class MeasureOptions:
         smoothing_sigma_px: Gaussian smoothing before the gradient (pixels).
         curvature_correction: move edge points outward by σ²κ/2, the shift of gradient
             maxima on a blurred curved edge (σ measured from the edge profile).
+        slope_correction: move each gradient-maximum edge point back by the shift that a
+            brightness slope beside the edge causes, (s₊ − s₋) σ² / A (the bore wall's
+            ramp inside a tilted rim; :mod:`measure.slope`; ``"parabola"`` edges only).
         arc_step_px: spacing of the lines through the centroid, in pixels of arc.
         short_gap_px: gaps up to this length (px) are filled along the contour and used in
             the fit; longer gaps are filled from the image ellipse, reported, not used.
@@ -50,6 +53,7 @@ class MeasureOptions:
     circle_cost: str = "orthogonal"
     smoothing_sigma_px: float = 0.5
     curvature_correction: bool = True
+    slope_correction: bool = True
     arc_step_px: float = 1.0
     short_gap_px: float = 4.0
     use_long_fills: bool = False
@@ -72,6 +76,7 @@ class MeasureOptions:
             circle_cost="published",
             use_long_fills=True,
             curvature_correction=False,
+            slope_correction=False,
             robust=False,
         )
 
