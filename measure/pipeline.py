@@ -28,7 +28,7 @@ from measure.errors import (
 )
 from measure.match import match_contours
 from measure.nearside import fit_with_near_side_check
-from measure.opening import with_wall_crescent
+from measure.opening import surface_level_search, with_wall_crescent
 from measure.pairing import pick_pair
 from measure.result import HoleMeasurement, MeasureOptions, RimChoice
 from measure.triangulate import triangulate
@@ -99,16 +99,7 @@ def _surface_level(small: np.ndarray, cand: HoleCandidate) -> float:
     the part's surface beyond any grommet or washer (fraction of full scale)."""
     s = SEARCH_SCALE
     cx, cy = (cand.centroid_px[0] - s // 2) / s, (cand.centroid_px[1] - s // 2) / s
-    d = cand.diameter_px / s
-    ang = np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)
-    rad = d * np.array([1.0, 1.25, 1.5])
-    xs = np.rint(cx + np.outer(rad, np.cos(ang))).astype(int).ravel()
-    ys = np.rint(cy + np.outer(rad, np.sin(ang))).astype(int).ravel()
-    H, W = small.shape
-    ok = (xs >= 0) & (ys >= 0) & (xs < W) & (ys < H)
-    if not ok.any():
-        return float(np.median(small)) / 255.0
-    return float(np.median(small[ys[ok], xs[ok]])) / 255.0
+    return surface_level_search(small, cx, cy, cand.diameter_px / s) / 255.0
 
 
 def _rim(cl, cr, reg_l, reg_r, small_l, small_r, depth_m) -> RimChoice:
