@@ -26,11 +26,10 @@ import time
 import numpy as np
 
 from cell.config import CellConfig, ReferenceTarget, load_cell
-from cell.run.reference import design_reference_plan
+from cell.run.reference import design_reference_plan, fixed_reference_plan
 from planner import Options, plan_tour
 from robots.thermal import CellGeometry, Observations, ThermalSpec, identify, reference_from_cold
 from robots.thermal.design import DesignOptions, evaluate
-from robots.thermal.plan import view_plan
 from thermal_truth import IndependentTruth, NetworkSettings
 
 TIMES_S = np.arange(0.0, 7200.0 + 1.0, 300.0)
@@ -44,13 +43,7 @@ THIRD_TARGET = ReferenceTarget(id="R3", position=[0.8, 0.0, 0.381], normal=[0, 0
 
 def old_plan(cell: CellConfig) -> list[tuple[str, np.ndarray]]:
     """The old recommended plan: three views per target (robots.thermal.plan defaults)."""
-    arm = cell.build_arm()
-    targets = {t.id: (t.position, t.normal) for t in cell.reference_targets}
-    plan = view_plan(
-        arm.dh, arm.lower, arm.upper, cell.T_cell_base(), cell.T_tool0_tcp(), targets,
-        cell.tool.standoff_m, accept=lambda q: not arm.in_collision(q),
-    )  # fmt: skip
-    return plan.poses
+    return fixed_reference_plan(cell)
 
 
 def _random_poses(cell: CellConfig, rng: np.random.Generator) -> np.ndarray:

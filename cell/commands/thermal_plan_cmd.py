@@ -25,13 +25,12 @@ import numpy as np
 from cell.commands.argtypes import non_negative_int, positive_float
 from cell.config import CellConfig, ReferenceTarget, load_cell
 from cell.errors import CellError
-from cell.run.reference import design_reference_plan, hole_stops
+from cell.run.reference import design_reference_plan, fixed_reference_plan, hole_stops
 from cell.run.setup import check_tour
 from cell.run.target_suggest import suggest_targets
 from planner import load_tour
 from robots.thermal.design import Design, DesignOptions, evaluate
 from robots.thermal.errors import ThermalError
-from robots.thermal.plan import view_plan
 
 VIEW_COLUMNS = ("view_id", "target_id", *(f"q{i}_rad" for i in range(1, 7)), "tilt_rad",
                 "azimuth_rad")  # fmt: skip
@@ -105,12 +104,7 @@ def _target(text: str, k: int) -> ReferenceTarget:
 
 def _old_plan_rms(cell: CellConfig, stops: np.ndarray, options: DesignOptions) -> float:
     arm = cell.build_arm()
-    targets = {t.id: (t.position, t.normal) for t in cell.reference_targets}
-    plan = view_plan(
-        arm.dh, arm.lower, arm.upper, cell.T_cell_base(), cell.T_tool0_tcp(), targets,
-        cell.tool.standoff_m, accept=lambda q: not arm.in_collision(q),
-    )  # fmt: skip
-    q = np.array([qq for _, qq in plan.poses])
+    q = np.array([qq for _, qq in fixed_reference_plan(cell)])
     sigma, _ = evaluate(arm.dh, cell.T_cell_base(), cell.T_tool0_tcp(), q, stops, options)
     return float(np.sqrt(np.mean(sigma**2)))
 

@@ -25,6 +25,7 @@ from planner.tour import LeftOut
 from planner.viewpoints import HoleCandidates, hole_candidates
 from robots.thermal.design import Design, DesignOptions, candidate_views, design_views
 from robots.thermal.errors import ThermalError
+from robots.thermal.plan import view_plan
 from robots.transforms import invert
 
 VIEW_SEPARATOR = "#"
@@ -85,6 +86,19 @@ def design_reference_plan(
         why = "; ".join(f"{t}: {r}" for t, r in skipped.items())
         raise CellError(f"cell {cell.name!r}: {exc}" + (f" ({why})" if why else "")) from exc
     return replace(design, skipped=skipped)
+
+
+def fixed_reference_plan(cell: CellConfig) -> list[tuple[str, NDArray[np.float64]]]:
+    """(target id, joint vector rad) of the fixed recommended plan, three views per reference
+    target (:func:`robots.thermal.plan.view_plan`'s defaults) under the cell's reach and
+    collision: the plan the designed one is compared with."""
+    arm = cell.build_arm()
+    targets = {r.id: (r.position, r.normal) for r in cell.reference_targets}
+    plan = view_plan(
+        arm.dh, arm.lower, arm.upper, cell.T_cell_base(), cell.T_tool0_tcp(), targets,
+        cell.tool.standoff_m, accept=lambda q: not arm.in_collision(q),
+    )  # fmt: skip
+    return plan.poses
 
 
 def reference_cell(cell: CellConfig, design: Design) -> CellConfig:
