@@ -11,12 +11,15 @@ every other motion is assumed free until a tour uses it. A round checks, in one 
   (at least ``CLUTTERED_HITS`` colliding tour motions), while all of a batch collide, the
   next twice as many, probed ``PROBE_COARSENESS`` times coarser than the set resolution
   (a colliding probe sample proves the collision; a free probe proves nothing);
+- above ``NEAR_ABOVE`` holes, in a cluttered round, each colliding tour motion's
+  *corridor* (``CORRIDOR``), probed;
 
 every colliding motion gets its roadmap detour cost, and a short repair search
 re-sequences from the tour. When the tour has no colliding motion left, its unknown
 motions are checked at the set resolution (a collision there: another round).
 
-Work limits, not clocks: at most ``LAZY_ROUNDS`` rounds per call; the time cap
+Work limits, not clocks: at most ``LAZY_ROUNDS`` rounds per call (above ``NEAR_ABOVE``
+holes, ``2 × LAZY_ROUNDS × NEAR_ABOVE / holes`` per start, all calls together); the time cap
 ``LAZY_BUDGET_SHARE`` × the sequencing budget (thread CPU time) only binds on a crawling
 machine (at 3× it bound on cluttered-80 and the same seed gave different tours).
 """
@@ -30,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planner.edge_check import BatchEdgeChecker
+from planner.lns import NEAR_ABOVE
 from planner.options import Options
 from planner.paths import MotionChecker
 from planner.roadmap import Roadmap, detour_costs
@@ -37,7 +41,10 @@ from planner.sequence import GtspSequencer, SequenceResult
 
 #: time cap of each repair search after costs changed, as a share of the sequencing budget
 REFINE_SHARE = 0.15
-#: at most this many lazy re-sequencing rounds ...
+#: at most this many lazy re-sequencing rounds per call, up to ``NEAR_ABOVE`` holes; above,
+#: a share ``NEAR_ABOVE / holes`` of it for the whole start, all calls together (each
+#: round's repair grows with the holes, and at 250 holes the rounds wander without
+#: converging: the tour after 30 rounds was as short as after 60) ...
 LAZY_ROUNDS = 60
 #: ... and a safety cap in time, as a multiple of the sequencing budget
 LAZY_BUDGET_SHARE = 20.0
@@ -50,6 +57,13 @@ CLUTTERED_HITS = 4
 #: probes are this many times coarser than the set resolution (a handful of samples per
 #: motion: a colliding one proves the collision, a free one proves nothing)
 PROBE_COARSENESS = 48.0
+#: above ``NEAR_ABOVE`` holes, in a cluttered round, each colliding tour motion between
+#: holes A and B also probes the motions of its *corridor*: between A or one of its
+#: ``CORRIDOR`` nearest holes and B or one of B's (the next search moves a blocked jump to
+#: the neighbouring holes, behind the same obstacle: at 250 holes, 65 % of the colliding
+#: tour motions joined holes within 3 of an earlier one's), the ``SIBLINGS`` cheapest
+#: unknown ones per hole pair that look cheaper than the detour
+CORRIDOR = 3
 
 
 class LazyEdgeChecks:
@@ -65,6 +79,7 @@ class LazyEdgeChecks:
     _probe_batch: BatchEdgeChecker
     _lazy_rounds: int
     _siblings: int
+    _corridor: int
 
     def _avoid_colliding_edges(
         self,
@@ -78,9 +93,12 @@ class LazyEdgeChecks:
         ``seen``: the tours the search accepted on its way to ``res``."""
         o = self.options
         started = time.thread_time()
-        for k in range(LAZY_ROUNDS + 1):
+        rounds = LAZY_ROUNDS
+        if n_holes > NEAR_ABOVE:
+            rounds = max(0, 2 * LAZY_ROUNDS * NEAR_ABOVE // n_holes - self._lazy_rounds)
+        for k in range(rounds + 1):
             on_tour = self._blocked_on_tours(seqr, res.nodes or [], seen, checker)
-            out_of_work = k == LAZY_ROUNDS
+            out_of_work = k == rounds
             out_of_time = time.thread_time() - started > LAZY_BUDGET_SHARE * o.budget_s(n_holes)
             if not on_tour or out_of_work or out_of_time:
                 break
@@ -132,7 +150,51 @@ class LazyEdgeChecks:
         hit = [e for e in blocked if e in on_tour]
         if hit:
             self._block_siblings(seqr, hit, checker)
+        if len(hit) >= CLUTTERED_HITS and len(seqr.groups) > NEAR_ABOVE:
+            self._block_corridors(seqr, hit, checker)
         return bool(hit)
+
+    def _block_corridors(
+        self, seqr: GtspSequencer, hit: list[tuple[int, int]], checker: MotionChecker
+    ) -> None:
+        """Probe the corridor of each colliding tour motion (see ``CORRIDOR``) in one batch;
+        the colliding probes are learned (a free probe proves nothing)."""
+        near = seqr.near_holes()[:, :CORRIDOR]
+        group = [np.array([0]), *seqr.groups]
+        keys: set[tuple[int, int]] = set()
+        for u, v in hit:
+            a, b = int(seqr.owner[u]) + 1, int(seqr.owner[v]) + 1
+            if a == 0 or b == 0:
+                continue
+            ends_a = [a, *(near[a - 1] + 1).tolist()]  # group indices: hole h is h + 1
+            ends_b = [b, *(near[b - 1] + 1).tolist()]
+            for a2, b2 in itertools.product(ends_a, ends_b):
+                if a2 == b2 or (a2, b2) == (a, b) or (a2, b2) == (b, a):
+                    continue
+                ga, gb = group[a2], group[b2]
+                C = seqr.G[np.ix_(ga, gb)]
+                order = np.argsort(C, axis=None, kind="stable")
+                order = order[C.ravel()[order] < seqr.G[u, v]]
+                found = 0
+                for f in order.tolist():
+                    i, j = divmod(f, len(gb))
+                    key = (min(int(ga[i]), int(gb[j])), max(int(ga[i]), int(gb[j])))
+                    if key in self._edge_free or key in self._coarse_free or key in keys:
+                        continue
+                    keys.add(key)
+                    found += 1
+                    if found == SIBLINGS:
+                        break
+        todo = sorted(keys)
+        if not todo:
+            return
+        free = self._free(self._probe_batch, seqr, todo, checker)
+        blocked = [k for k, f in zip(todo, free.tolist(), strict=True) if not f]
+        for k in blocked:
+            self._edge_free[k] = False
+        self._corridor += len(blocked)
+        if blocked:
+            seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
 
     def _block_siblings(
         self, seqr: GtspSequencer, hit: list[tuple[int, int]], checker: MotionChecker

@@ -235,6 +235,7 @@ class TourPlanner(LazyEdgeChecks):
         self._lazy_rounds = 0
         self._coarse_free: set[tuple[int, int]] = set()  # free at the coarse resolution
         self._siblings = 0
+        self._corridor = 0
         seqr = shared.sequencer
         if self.sequencer is not None or seqr is None:
             res = self.sequencer(home, cands, limits)
@@ -390,6 +391,7 @@ class TourPlanner(LazyEdgeChecks):
             "roadmap_edges_checked": self._roadmap.checked,
             "lazy_rounds": self._lazy_rounds,
             "lazy_siblings_blocked": self._siblings,
+            "lazy_corridor_blocked": self._corridor,
             "roadmap_edges_blocked": sum(not f for f in self._roadmap.free.values()),
             "collision_checks": checker.checks,
         }

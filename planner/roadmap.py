@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
@@ -42,6 +43,30 @@ class Roadmap:
     _edges: tuple[int, NDArray[np.int64], NDArray[np.int64]] | None = field(
         default=None, repr=False, compare=False
     )
+    #: Dijkstra rows (distances s, predecessors) by source node, valid for the edge weights
+    #: ``_weights`` (a start's learned costs rarely touch a free motion); not pickled
+    _rows: dict[int, tuple[NDArray[np.float64], NDArray[np.int32]]] = field(
+        default_factory=dict, repr=False, compare=False
+    )
+    _weights: NDArray[np.float64] | None = field(default=None, repr=False, compare=False)
+
+    def __getstate__(self) -> dict[str, object]:
+        return self.__dict__ | {"_rows": {}, "_weights": None}
+
+    def shortest_from(
+        self, graph: csr_matrix, sources: NDArray[np.int64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.int32]]:
+        """Dijkstra's distances (s) and predecessors from each of ``sources`` over ``graph``
+        (:meth:`graph`), one row per source; rows already computed for the same weights are
+        reused (the same numbers: each row depends on its source only)."""
+        if self._weights is None or not np.array_equal(self._weights, graph.data):
+            self._rows, self._weights = {}, graph.data.copy()
+        todo = [int(s) for s in sources if int(s) not in self._rows]
+        if todo:
+            dist, pred = dijkstra(graph, directed=False, indices=todo, return_predecessors=True)
+            self._rows.update(zip(todo, zip(dist, pred, strict=True), strict=True))
+        rows = [self._rows[int(s)] for s in sources]
+        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
 
     def graph(self, G: NDArray[np.float64]) -> csr_matrix | None:
         """The free motions as a sparse graph weighted by the current ``G`` (s), or None.
@@ -100,6 +125,29 @@ def build_roadmap(
     return rm
 
 
+@njit(cache=True)
+def _walk_back(
+    pred: NDArray[np.int32], rows: NDArray[np.int64], u: NDArray[np.int64], v: NDArray[np.int64]
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The intermediate nodes of each shortest path ``u[i]`` → ``v[i]`` (Dijkstra predecessors
+    ``pred[rows[i]]``), in order, flattened; and each path's offset in it."""
+    offsets = np.zeros(len(u) + 1, dtype=np.int64)
+    for i in range(len(u)):
+        x, hops = v[i], 0
+        while x != u[i]:
+            x = pred[rows[i], x]
+            hops += 1
+        offsets[i + 1] = offsets[i] + hops - 1
+    flat = np.empty(offsets[-1], dtype=np.int64)
+    for i in range(len(u)):
+        x, k = pred[rows[i], v[i]], offsets[i + 1] - 1
+        while x != u[i]:
+            flat[k] = x
+            x = pred[rows[i], x]
+            k -= 1
+    return flat, offsets
+
+
 def detour_costs(
     rm: Roadmap, G: NDArray[np.float64], blocked: list[tuple[int, int]]
 ) -> dict[tuple[int, int], float]:
@@ -109,22 +157,18 @@ def detour_costs(
     """
     if not blocked:
         return {}
-    out: dict[tuple[int, int], float] = {}
-    sources = sorted({u for u, _ in blocked})
-    dist = pred = None
+    uv = np.array(blocked, dtype=np.int64).reshape(-1, 2)
+    u, v = uv[:, 0], uv[:, 1]
+    cost = DETOUR_FACTOR * G[u, v] + DETOUR_EXTRA_S
     graph = rm.graph(G)
     if graph is not None:
-        dist, pred = dijkstra(graph, directed=False, indices=sources, return_predecessors=True)
-    row = {s: i for i, s in enumerate(sources)}
-    for u, v in blocked:
-        estimate = DETOUR_FACTOR * G[u, v] + DETOUR_EXTRA_S
-        if dist is not None and np.isfinite(dist[row[u], v]):
-            path, x = [], v
-            while x != u:
-                x = int(pred[row[u], x])
-                path.append(x)
-            rm.detours[(u, v)] = path[::-1][1:]
-            out[(u, v)] = max(float(dist[row[u], v]), float(G[u, v]))
-        else:
-            out[(u, v)] = estimate
-    return out
+        sources, rows = np.unique(u, return_inverse=True)
+        dist, pred = rm.shortest_from(graph, sources)
+        d = dist[rows, v]
+        found = np.flatnonzero(np.isfinite(d))
+        cost[found] = np.maximum(d[found], G[u[found], v[found]])
+        flat, offsets = _walk_back(pred, rows[found], u[found], v[found])
+        flat_l, off_l = flat.tolist(), offsets.tolist()
+        for k, i in enumerate(found.tolist()):
+            rm.detours[(int(u[i]), int(v[i]))] = flat_l[off_l[k] : off_l[k + 1]]
+    return dict(zip(map(tuple, uv.tolist()), cost.tolist(), strict=True))

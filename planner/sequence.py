@@ -27,7 +27,7 @@ from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
 from planner.costs import CostTable, cost_matrix, travel_time
 from planner.errors import PlanningError
-from planner.lns import GtspLns, LnsSettings
+from planner.lns import NEAR_ABOVE, GtspLns, LnsSettings, near_holes
 from planner.pyvrp_gtsp import solve_gtsp_pyvrp
 from planner.timing import JointLimits
 
@@ -207,6 +207,14 @@ class GtspSequencer:
         self.G = table.matrix(self.nodes, self.nodes).astype(np.float64)
         self.lim = (limits.velocity, limits.acceleration, limits.jerk)
         self.learned: dict[tuple[int, int], float] = {}
+        self._near: NDArray[np.int64] | None = None  # planner.lns.near_holes, made once
+
+    def near_holes(self) -> NDArray[np.int64]:
+        """Row h: the holes nearest hole h (:func:`planner.lns.near_holes`), made once, from
+        the costs of the first call (a neighbour list only guides which moves are tried)."""
+        if self._near is None:
+            self._near = near_holes(self.G, self.groups)
+        return self._near
 
     def learn(self, costs: dict[tuple[int, int], float]) -> None:
         """Set measured costs (s) for node pairs, both directions."""
@@ -252,7 +260,8 @@ class GtspSequencer:
                 time_limit_s=time_budget_s,
             )
             start = None if warm is None else [int(self.owner[v]) for v in warm]
-            found = GtspLns(self.G, self.groups, seed, record).run(settings, start)
+            near = self.near_holes() if n > NEAR_ABOVE else None
+            found = GtspLns(self.G, self.groups, seed, record, near).run(settings, start)
             visited, hit = found.nodes, found.hit_time_limit
         elif self.method == "pyvrp":
             base, per_hole = PYVRP_ITERATIONS

@@ -1,0 +1,384 @@
+"""The inner loops of the GTSP search (:mod:`planner.lns`), compiled by Numba.
+
+Every function here is the scalar form of a numpy expression that the search used
+before (kept in :mod:`planner.local_search` and in the tests as the reference): the
+same arithmetic in the same order, and ties broken the same way (the first minimum in
+row-major order, as ``np.argmin``), so the tours are the same, bit for bit. What
+changes is the cost: no temporary matrices and no Python loop over the tour's layers.
+
+``G`` is the cost matrix (s) of the search's nodes, ``path`` a node list with home
+(node 0) at both ends; a hole's nodes are ``gnodes[goff[h]:goff[h + 1]]``.
+
+Compiled on first use and cached beside this file (``cache=True``): a fresh process
+loads the machine code instead of compiling again.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+#: a move must improve a tour by more than this (s) to be applied (as planner.local_search)
+EPS_S = 1e-9
+
+
+@njit(cache=True)
+def _two_opt(C: NDArray[np.float64], p: NDArray[np.int64]) -> tuple[float, int, int]:
+    """Best 2-opt move on the path ``p`` of ``C``: reverse ``p[i+1 .. j]`` (delta_s, i, j)."""
+    m = p.shape[0] - 1
+    best, bi, bj = np.inf, 0, 0
+    for i in range(m):
+        ei = C[p[i], p[i + 1]]
+        for j in range(i + 2, m):
+            d = C[p[i], p[j]] + C[p[i + 1], p[j + 1]] - ei - C[p[j], p[j + 1]]
+            if d < best:
+                best, bi, bj = d, i, j
+    return best, bi, bj
+
+
+@njit(cache=True)
+def _or_opt(
+    C: NDArray[np.float64], p: NDArray[np.int64], length: int
+) -> tuple[float, int, int, bool]:
+    """Best move of the segment ``p[i .. i+length-1]`` to the edge (j, j+1), maybe reversed
+    (delta_s, i, j, reversed); home ends never move."""
+    m = p.shape[0] - 1
+    if m - length < 1 or m < 2:
+        return np.inf, 0, 0, False
+    best, bs, bj, brev = np.inf, 1, 0, False
+    for s in range(1, m - length + 1):
+        e = s + length - 1
+        removal = C[p[s - 1], p[e + 1]] - C[p[s - 1], p[s]] - C[p[e], p[e + 1]]
+        for j in range(m):
+            if s - 1 <= j <= e:
+                continue
+            base = removal - C[p[j], p[j + 1]]
+            fwd = C[p[s], p[j]] + C[p[e], p[j + 1]] + base
+            rev = C[p[e], p[j]] + C[p[s], p[j + 1]] + base
+            d = min(fwd, rev)
+            if d < best:
+                best, bs, bj, brev = d, s, j, rev < fwd
+    return best, bs, bj, brev
+
+
+@njit(cache=True)
+def improve_path(
+    G: NDArray[np.float64], path: NDArray[np.int64], max_moves: int
+) -> NDArray[np.int64]:
+    """Local optimum of 2-opt and or-opt (segments of 1-3), best improvement first, from the
+    order of ``path`` (home ends stay); returns the permutation of path positions."""
+    n = path.shape[0]
+    C = np.empty((n, n))
+    for a in range(n):
+        for b in range(n):
+            C[a, b] = G[path[a], path[b]]
+    p = np.arange(n)
+    for _ in range(max_moves):
+        d, i, j = _two_opt(C, p)
+        kind, length, rev = 0, 0, False
+        for ln in (1, 2, 3):
+            d2, i2, j2, r2 = _or_opt(C, p, ln)
+            if d2 < d:
+                d, i, j, kind, length, rev = d2, i2, j2, 1, ln, r2
+        if not d < -EPS_S:
+            break
+        if kind == 0:
+            p[i + 1 : j + 1] = p[i + 1 : j + 1][::-1].copy()
+            continue
+        seg = p[i : i + length].copy()
+        if rev:
+            seg = seg[::-1].copy()
+        rest = np.concatenate((p[:i], p[i + length :]))
+        at = j + 1 if j < i else j + 1 - length
+        p = np.concatenate((rest[:at], seg, rest[at:]))
+    return p
+
+
+@njit(cache=True)
+def layered(
+    G: NDArray[np.float64],
+    order: NDArray[np.int64],
+    gnodes: NDArray[np.int64],
+    goff: NDArray[np.int64],
+) -> tuple[NDArray[np.int64], float]:
+    """Exact best node per hole for the hole ``order``, home at both ends (layered shortest
+    path); returns the nodes and the tour cost (s)."""
+    n = order.shape[0]
+    out = np.empty(n, dtype=np.int64)
+    if n == 0:
+        return out, 0.0
+    kmax = 0
+    for h in order:
+        kmax = max(kmax, goff[h + 1] - goff[h])
+    back = np.zeros((n, kmax), dtype=np.int64)
+    a0 = goff[order[0]]
+    ka = goff[order[0] + 1] - a0
+    dist = np.empty(kmax)
+    for a in range(ka):
+        dist[a] = G[0, gnodes[a0 + a]]
+    new = np.empty(kmax)
+    for li in range(1, n):
+        b0 = goff[order[li]]
+        kb = goff[order[li] + 1] - b0
+        for b in range(kb):
+            vb = gnodes[b0 + b]
+            best, arg = np.inf, 0
+            for a in range(ka):
+                t = dist[a] + G[gnodes[a0 + a], vb]
+                if t < best:
+                    best, arg = t, a
+            new[b] = best
+            back[li, b] = arg
+        dist[:kb] = new[:kb]
+        a0, ka = b0, kb
+    best, pick = np.inf, 0
+    for a in range(ka):
+        t = dist[a] + G[gnodes[a0 + a], 0]
+        if t < best:
+            best, pick = t, a
+    for li in range(n - 1, -1, -1):
+        out[li] = gnodes[goff[order[li]] + pick]
+        pick = back[li, pick]
+    return out, best
+
+
+@njit(cache=True)
+def insert(
+    G: NDArray[np.float64],
+    order: NDArray[np.int64],
+    nodes: NDArray[np.int64],
+    removed: NDArray[np.int64],
+    gnodes: NDArray[np.int64],
+    goff: NDArray[np.int64],
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Insert each ``removed`` hole, in turn, at its cheapest position with its cheapest
+    node; returns the hole order and the nodes."""
+    n = order.shape[0] + removed.shape[0]
+    o = np.empty(n, dtype=np.int64)
+    v = np.empty(n, dtype=np.int64)
+    k = order.shape[0]
+    o[:k] = order
+    v[:k] = nodes
+    for h in removed:
+        best, be, bc = np.inf, 0, 0
+        for e in range(k + 1):
+            a = 0 if e == 0 else v[e - 1]
+            b = 0 if e == k else v[e]
+            edge = G[a, b]
+            for c in range(goff[h], goff[h + 1]):
+                x = G[a, gnodes[c]] + G[gnodes[c], b] - edge
+                if x < best:
+                    best, be, bc = x, e, c
+        o[be + 1 : k + 1] = o[be:k].copy()
+        v[be + 1 : k + 1] = v[be:k].copy()
+        o[be] = h
+        v[be] = gnodes[bc]
+        k += 1
+    return o, v
+
+
+# --- large tours: moves between neighbouring holes only -------------------------------
+#
+# Above ``planner.lns.NEAR_ABOVE`` holes a full scan of every move costs O(n²) per move
+# and finds little that the neighbour moves miss (the standard candidate-list technique
+# of TSP local search): the moves below only join a hole to one of its ``K`` nearest
+# holes (``near[h]``, hole indices), in O(n K) per move. ``order`` is the hole order of
+# ``path`` (``path[1 + i]`` is a node of hole ``order[i]``).
+
+
+@njit(cache=True)
+def _positions(p: NDArray[np.int64], order: NDArray[np.int64], holes: int) -> NDArray[np.int64]:
+    """Current path position of each hole (-1: not on the path)."""
+    pos = np.full(holes, -1, dtype=np.int64)
+    for i in range(1, p.shape[0] - 1):
+        pos[order[p[i] - 1]] = i
+    return pos
+
+
+@njit(cache=True)
+def _best_near_move(
+    C: NDArray[np.float64],
+    p: NDArray[np.int64],
+    pos: NDArray[np.int64],
+    i: int,
+    near_h: NDArray[np.int64],
+) -> tuple[float, int, int, int, int, bool]:
+    """The best move joining the hole at position ``i`` to one of ``near_h``: 2-opt moves
+    whose new edges include that pair, or-opt moves of a segment ending at ``i`` to either
+    side of the neighbour (delta_s, kind 0/1, i, j, length, reversed)."""
+    m = p.shape[0] - 1
+    best, kind, bi, bj, blen, brev = -EPS_S, -1, 0, 0, 0, False
+    for x in near_h:
+        j = pos[x]
+        if j < 0:
+            continue
+        a, b = min(i, j), max(i, j)
+        if b >= a + 2:  # new edges (a, b) and (a+1, b+1), or (a-1, b-1) and (a, b)
+            for s in (a, a - 1):
+                t = s + b - a
+                if s < 0 or t >= m:
+                    continue
+                d = C[p[s], p[t]] + C[p[s + 1], p[t + 1]] - C[p[s], p[s + 1]] - C[p[t], p[t + 1]]
+                if d < best:
+                    best, kind, bi, bj = d, 0, s, t
+        for length in (1, 2, 3):
+            if m - length < 1:
+                continue
+            for s in (i, i - length + 1):
+                e = s + length - 1
+                if s < 1 or s > m - length:
+                    continue
+                removal = C[p[s - 1], p[e + 1]] - C[p[s - 1], p[s]] - C[p[e], p[e + 1]]
+                for t in (j - 1, j):
+                    if t < 0 or t >= m or s - 1 <= t <= e:
+                        continue
+                    base = removal - C[p[t], p[t + 1]]
+                    fwd = C[p[s], p[t]] + C[p[e], p[t + 1]] + base
+                    rev = C[p[e], p[t]] + C[p[s], p[t + 1]] + base
+                    d = min(fwd, rev)
+                    if d < best:
+                        best, kind, bi, bj, blen, brev = d, 1, s, t, length, rev < fwd
+    return best, kind, bi, bj, blen, brev
+
+
+@njit(cache=True)
+def improve_path_near(
+    G: NDArray[np.float64],
+    path: NDArray[np.int64],
+    order: NDArray[np.int64],
+    near: NDArray[np.int64],
+    max_moves: int,
+) -> NDArray[np.int64]:
+    """A local optimum of the neighbour moves (:func:`_best_near_move`) from the order of
+    ``path``: each hole in a queue (first all, in path order) applies its best improving
+    move; the holes at the ends of the edges a move changed join the queue again ("don't
+    look bits"). ``C`` must be symmetric. Returns the permutation of path positions."""
+    n = path.shape[0]
+    C = np.empty((n, n))
+    for a in range(n):
+        for b in range(n):
+            C[a, b] = G[path[a], path[b]]
+    p = np.arange(n)
+    holes = near.shape[0]
+    pos = _positions(p, order, holes)
+    queue = np.empty(n - 2 + 6 * max_moves, dtype=np.int64)
+    queued = np.zeros(holes, dtype=np.bool_)
+    tail = 0
+    for i in range(1, n - 1):
+        queue[tail] = order[i - 1]
+        queued[order[i - 1]] = True
+        tail += 1
+    head, moves = 0, 0
+    while head < tail and moves < max_moves:
+        h = queue[head]
+        head += 1
+        queued[h] = False
+        _d, kind, bi, bj, blen, brev = _best_near_move(C, p, pos, pos[h], near[h])
+        if kind < 0:
+            continue
+        moves += 1
+        if kind == 0:
+            ends = (bi, bi + 1, bj, bj + 1)
+            touched = np.array([p[k] for k in ends])
+            p[bi + 1 : bj + 1] = p[bi + 1 : bj + 1][::-1].copy()
+        else:
+            e = bi + blen - 1
+            touched = np.array([p[bi - 1], p[bi], p[e], p[e + 1], p[bj], p[bj + 1]])
+            seg = p[bi : bi + blen].copy()
+            if brev:
+                seg = seg[::-1].copy()
+            rest = np.concatenate((p[:bi], p[bi + blen :]))
+            at = bj + 1 if bj < bi else bj + 1 - blen
+            p = np.concatenate((rest[:at], seg, rest[at:]))
+        pos = _positions(p, order, holes)
+        for q in touched:
+            if 1 <= q <= n - 2 and not queued[order[q - 1]]:
+                queue[tail] = order[q - 1]
+                queued[order[q - 1]] = True
+                tail += 1
+    return p
+
+
+@njit(cache=True)
+def insert_near(
+    G: NDArray[np.float64],
+    order: NDArray[np.int64],
+    nodes: NDArray[np.int64],
+    removed: NDArray[np.int64],
+    gnodes: NDArray[np.int64],
+    goff: NDArray[np.int64],
+    near: NDArray[np.int64],
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`insert` trying only the positions beside a hole's neighbours on the tour
+    (every position when none of them is on it). ``G`` must be symmetric."""
+    holes = near.shape[0]
+    n = order.shape[0] + removed.shape[0]
+    o = np.empty(n, dtype=np.int64)
+    v = np.empty(n, dtype=np.int64)
+    k = order.shape[0]
+    o[:k] = order
+    v[:k] = nodes
+    pos = np.full(holes, -1, dtype=np.int64)
+    for i in range(k):
+        pos[o[i]] = i
+    tried = np.zeros(n + 1, dtype=np.bool_)
+    for h in removed:
+        best, be, bc = np.inf, -1, 0
+        tried[: k + 1] = False
+        cands = np.empty(2 * near.shape[1], dtype=np.int64)
+        nc = 0
+        for x in near[h]:
+            q = pos[x]
+            if q < 0:
+                continue
+            for e in (q, q + 1):
+                if not tried[e]:
+                    tried[e] = True
+                    cands[nc] = e
+                    nc += 1
+        if nc == 0:
+            cands = np.arange(k + 1)
+            nc = k + 1
+        cands[:nc].sort()
+        for ci in range(nc):
+            e = cands[ci]
+            a = 0 if e == 0 else v[e - 1]
+            b = 0 if e == k else v[e]
+            edge = G[a, b]
+            for c in range(goff[h], goff[h + 1]):
+                x2 = G[a, gnodes[c]] + G[b, gnodes[c]] - edge
+                if x2 < best:
+                    best, be, bc = x2, e, c
+        o[be + 1 : k + 1] = o[be:k].copy()
+        v[be + 1 : k + 1] = v[be:k].copy()
+        o[be] = h
+        v[be] = gnodes[bc]
+        k += 1
+        for i in range(be, k):
+            pos[o[i]] = i
+    return o, v
+
+
+def compile_kernels() -> None:
+    """Compile (or load from the cache) every kernel on a tiny problem, so that a search's
+    work limits and time cap (:mod:`planner.lns`) never count the compiler; fast after
+    the first call in a process."""
+    global _compiled
+    if _compiled:
+        return
+    G = np.ones((4, 4))
+    path = np.array([0, 1, 2, 3, 0], dtype=np.int64)
+    holes = np.array([0, 1, 2], dtype=np.int64)
+    near = np.array([[1, 2], [0, 2], [0, 1]], dtype=np.int64)
+    gnodes, goff = np.array([1, 2, 3], dtype=np.int64), np.array([0, 1, 2, 3], dtype=np.int64)
+    improve_path(G, path, 1)
+    improve_path_near(G, path, holes, near, 1)
+    layered(G, holes, gnodes, goff)
+    one, rest = holes[:1], holes[1:]
+    insert(G, one, gnodes[:1], rest, gnodes, goff)
+    insert_near(G, one, gnodes[:1], rest, gnodes, goff, near)
+    _compiled = True
+
+
+_compiled = False
