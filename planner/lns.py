@@ -24,6 +24,7 @@ on a slow machine (then the result is reported as such).
 
 from __future__ import annotations
 
+import itertools
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -31,17 +32,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from planner.lns_kernel import (
-    compile_kernels,
-    improve_path,
-    improve_path_near,
-    insert,
-    insert_near,
-    layered,
-)
+from planner.local_search import improve_order
 
 #: at most this many moves per local optimisation (a bound that a tour never reaches)
 MAX_MOVES = 10_000
+#: above this many holes the search's loops run compiled (:mod:`planner.lns_kernel`; the
+#: same numbers as the numpy code here, bit for bit), below it Numba's ~1 s of loading
+#: per process costs more than it saves (the frame: 41 holes)
+COMPILED_ABOVE = 60
 #: above this many holes, moves and insertions only join a hole to one of its ``NEAR_K``
 #: nearest holes (:mod:`planner.lns_kernel`); up to it, every move is scanned
 NEAR_ABOVE = 120
@@ -81,6 +79,45 @@ class LnsResult:
     hit_time_limit: bool
 
 
+def layered_nodes(
+    G: NDArray[np.floating],
+    layers: Sequence[NDArray[np.int64]],
+    spans: Sequence[tuple[int, int]] | None = None,
+) -> tuple[list[int], float]:
+    """Exact best node per layer for a fixed order of layers, home (node 0) at both ends.
+
+    ``spans`` (optional): ``(first, end)`` of each layer when it is the contiguous range
+    ``first .. end-1`` of nodes (then the blocks of ``G`` are read as views, not copies:
+    the same numbers, a third of the time)."""
+    if not layers:
+        return [], 0.0
+    blocks = (
+        [G[a0:a1, b0:b1] for (a0, a1), (b0, b1) in itertools.pairwise(spans)]
+        if spans is not None
+        else [G[prev[:, None], cur[None, :]] for prev, cur in itertools.pairwise(layers)]
+    )
+    dist = G[0, layers[0]].astype(float)
+    back = []
+    for block in blocks:
+        total = dist[:, None] + block
+        back.append(np.argmin(total, axis=0))
+        dist = total.min(axis=0)
+    total = dist + G[layers[-1], 0]
+    pick = [int(np.argmin(total))]
+    cost = float(total[pick[0]])
+    for arg in reversed(back):
+        pick.append(int(arg[pick[-1]]))
+    pick.reverse()
+    return [int(layer[p]) for layer, p in zip(layers, pick, strict=True)], cost
+
+
+def _span(group: NDArray[np.int64]) -> tuple[int, int] | None:
+    """``(first, end)`` when ``group`` is the range ``first .. end-1``, else None."""
+    if len(group) and np.array_equal(group, np.arange(group[0], group[0] + len(group))):
+        return int(group[0]), int(group[0]) + len(group)
+    return None
+
+
 class GtspLns:
     """The search over one problem instance (see module docstring)."""
 
@@ -91,32 +128,53 @@ class GtspLns:
         seed: int,
         record: list[list[int]] | None = None,
         near: NDArray[np.int64] | None = None,
+        compiled: bool | None = None,
     ) -> None:
-        """``near``: :func:`near_holes` of ``G`` (made here when needed and not given)."""
-        self.G = np.ascontiguousarray(G, dtype=np.float64)  # no copy of the planner's matrix
+        """``near``: :func:`near_holes` of ``G`` (made here when needed and not given);
+        ``compiled``: run the compiled loops (default: above ``COMPILED_ABOVE`` holes)."""
+        self.G = G
         self.groups = [np.asarray(g, dtype=np.int64) for g in groups]
-        self.gnodes = np.concatenate([np.zeros(0, dtype=np.int64), *self.groups])
-        self.goff = np.cumsum([0] + [len(g) for g in self.groups]).astype(np.int64)
         self.rng = np.random.default_rng(seed)
         self.record = record
+        self.k = None
         self.near = None
-        if len(self.groups) > NEAR_ABOVE:
-            self.near = near_holes(self.G, self.groups) if near is None else near
+        if len(self.groups) > COMPILED_ABOVE if compiled is None else compiled:
+            from planner import lns_kernel  # Numba: loaded only where it pays
+
+            self.k = lns_kernel
+            self.G = np.ascontiguousarray(G, dtype=np.float64)  # no copy of the planner's
+            self.gnodes = np.concatenate([np.zeros(0, dtype=np.int64), *self.groups])
+            self.goff = np.cumsum([0] + [len(g) for g in self.groups]).astype(np.int64)
+            if len(self.groups) > NEAR_ABOVE:
+                self.near = near_holes(self.G, self.groups) if near is None else near
+        spans = [_span(g) for g in self.groups]
+        self.spans: list[tuple[int, int]] | None = (
+            None if any(s is None for s in spans) else spans  # type: ignore[assignment]
+        )
 
     def _rechoose(self, order: list[int]) -> tuple[list[int], list[int], float]:
-        nodes, cost = layered(self.G, np.array(order, dtype=np.int64), self.gnodes, self.goff)
-        return order, nodes.tolist(), float(cost)
+        if self.k is not None:
+            holes = np.array(order, dtype=np.int64)
+            nodes, cost = self.k.layered(self.G, holes, self.gnodes, self.goff)
+            return order, nodes.tolist(), float(cost)
+        spans = None if self.spans is None else [self.spans[h] for h in order]
+        nodes, cost = layered_nodes(self.G, [self.groups[h] for h in order], spans)
+        return order, nodes, cost
 
     def _local(
         self, order: list[int], nodes: list[int], cost: float
     ) -> tuple[list[int], list[int], float]:
         for _ in range(2):
-            path = np.array([0, *nodes, 0], dtype=np.int64)
-            if self.near is None:
-                perm = improve_path(self.G, path, MAX_MOVES).tolist()
+            path = [0, *nodes, 0]
+            if self.k is None:
+                perm = improve_order(self.G[np.ix_(path, path)].astype(float))
+            elif self.near is None:
+                perm = self.k.improve_path(self.G, np.array(path), MAX_MOVES).tolist()
             else:
                 holes = np.array(order, dtype=np.int64)
-                perm = improve_path_near(self.G, path, holes, self.near, MAX_MOVES).tolist()
+                perm = self.k.improve_path_near(
+                    self.G, np.array(path), holes, self.near, MAX_MOVES
+                ).tolist()
             inner = [p - 1 for p in perm[1:-1]]
             o2, n2, c2 = self._rechoose([order[p] for p in inner])
             if not c2 < cost - 1e-9:
@@ -158,16 +216,26 @@ class GtspLns:
         self, order: list[int], nodes: list[int], removed: list[int]
     ) -> tuple[list[int], list[int]]:
         """Each removed hole, in turn, at its cheapest position with its cheapest node."""
-        args = (
-            self.G,
-            np.array(order, dtype=np.int64),
-            np.array(nodes, dtype=np.int64),
-            np.array(removed, dtype=np.int64),
-            self.gnodes,
-            self.goff,
-        )
-        o, v = insert(*args) if self.near is None else insert_near(*args, self.near)
-        return o.tolist(), v.tolist()
+        if self.k is not None:
+            args = (self.G, np.array(order), np.array(nodes), np.array(removed))
+            args += (self.gnodes, self.goff)
+            o, v = (
+                self.k.insert(*args) if self.near is None else self.k.insert_near(*args, self.near)
+            )
+            return o.tolist(), v.tolist()
+        for h in removed:
+            path = np.array([0, *nodes, 0])
+            cand = self.groups[h]
+            if self.spans is not None:  # views of the contiguous columns: the same numbers
+                c0, c1 = self.spans[h]
+                into, out = self.G[path[:-1], c0:c1], self.G[c0:c1, path[1:]].T
+            else:
+                into, out = self.G[np.ix_(path[:-1], cand)], self.G[np.ix_(cand, path[1:])].T
+            extra = into + out - self.G[path[:-1], path[1:]][:, None]
+            e, c = divmod(int(np.argmin(extra)), extra.shape[1])
+            order.insert(e, h)
+            nodes.insert(e, int(cand[c]))
+        return order, nodes
 
     def _path_cost(self, nodes: list[int]) -> float:
         path = np.array([0, *nodes, 0])
@@ -175,7 +243,8 @@ class GtspLns:
 
     def run(self, settings: LnsSettings, start: list[int] | None = None) -> LnsResult:
         """Search from ``start`` (a hole order) or the greedy tour; returns the best tour found."""
-        compile_kernels()  # before the clock starts
+        if self.k is not None:
+            self.k.compile_kernels()  # before the clock starts
         started = time.thread_time()
         cur = best = self.initial() if start is None else self._local(*self._rechoose(list(start)))
         n = len(self.groups)

@@ -20,6 +20,7 @@ import time
 
 from planner.engines import Engine, LocalEngine
 from planner.errors import PlanningError, StartsFailedError
+from planner.lns import COMPILED_ABOVE
 from planner.options import Options
 from planner.planner import TourPlanner
 from planner.protocols import CellLike
@@ -81,7 +82,9 @@ def plan_multistart(
     calls = [(cell, dataclasses.replace(options, seed=s)) for s in seeds]
     warm_up = getattr(engine, "warm_up", None)
     if warm_up is not None:  # workers import the planner while the shared part is computed
-        warm_up([type(cell).__module__])
+        # (and load the compiled search where the starts use it: planner.warm)
+        compiled = len(cell.holes_in_cell()) > COMPILED_ABOVE
+        warm_up([type(cell).__module__, *(["planner.warm"] if compiled else [])])
     shared_info: dict[str, float] = {}
     blob = None
     if share:

@@ -20,7 +20,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
@@ -125,29 +124,6 @@ def build_roadmap(
     return rm
 
 
-@njit(cache=True)
-def _walk_back(
-    pred: NDArray[np.int32], rows: NDArray[np.int64], u: NDArray[np.int64], v: NDArray[np.int64]
-) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """The intermediate nodes of each shortest path ``u[i]`` → ``v[i]`` (Dijkstra predecessors
-    ``pred[rows[i]]``), in order, flattened; and each path's offset in it."""
-    offsets = np.zeros(len(u) + 1, dtype=np.int64)
-    for i in range(len(u)):
-        x, hops = v[i], 0
-        while x != u[i]:
-            x = pred[rows[i], x]
-            hops += 1
-        offsets[i + 1] = offsets[i] + hops - 1
-    flat = np.empty(offsets[-1], dtype=np.int64)
-    for i in range(len(u)):
-        x, k = pred[rows[i], v[i]], offsets[i + 1] - 1
-        while x != u[i]:
-            flat[k] = x
-            x = pred[rows[i], x]
-            k -= 1
-    return flat, offsets
-
-
 def detour_costs(
     rm: Roadmap, G: NDArray[np.float64], blocked: list[tuple[int, int]]
 ) -> dict[tuple[int, int], float]:
@@ -167,8 +143,10 @@ def detour_costs(
         d = dist[rows, v]
         found = np.flatnonzero(np.isfinite(d))
         cost[found] = np.maximum(d[found], G[u[found], v[found]])
-        flat, offsets = _walk_back(pred, rows[found], u[found], v[found])
-        flat_l, off_l = flat.tolist(), offsets.tolist()
-        for k, i in enumerate(found.tolist()):
-            rm.detours[(int(u[i]), int(v[i]))] = flat_l[off_l[k] : off_l[k + 1]]
+        for i in found.tolist():
+            a, x, row, path = int(u[i]), int(v[i]), pred[rows[i]], []
+            while x != a:
+                x = int(row[x])
+                path.append(x)
+            rm.detours[(a, int(v[i]))] = path[::-1][1:]
     return dict(zip(map(tuple, uv.tolist()), cost.tolist(), strict=True))

@@ -1,5 +1,5 @@
-"""The compiled GTSP kernels: bit for bit the numpy reference; the neighbour moves of large
-tours; the Dijkstra rows reused by the roadmap's detour costs."""
+"""The compiled GTSP kernels: bit for bit the numpy code they replace above 60 holes; the
+neighbour moves of large tours; the Dijkstra rows reused by the roadmap's detour costs."""
 
 from __future__ import annotations
 
@@ -7,9 +7,8 @@ import pickle
 
 import numpy as np
 import pytest
-from lns_reference import improve_order, insert_reference, layered_nodes
 
-from planner.lns import NEAR_ABOVE, GtspLns, LnsSettings, near_holes
+from planner.lns import NEAR_ABOVE, GtspLns, LnsSettings, layered_nodes, near_holes
 from planner.lns_kernel import (
     improve_path,
     improve_path_near,
@@ -17,6 +16,7 @@ from planner.lns_kernel import (
     insert_near,
     layered,
 )
+from planner.local_search import improve_order
 from planner.roadmap import Roadmap, detour_costs
 
 MOVES = 10_000  # improve_order's default bound
@@ -51,8 +51,18 @@ def test_kernels_equal_the_numpy_reference_bit_for_bit(seed: int) -> None:
     o, v = insert(
         G, keep.astype(np.int64), nodes[: len(keep)], removed.astype(np.int64), gnodes, goff
     )
-    ref = insert_reference(G, keep.tolist(), nodes[: len(keep)].tolist(), removed.tolist(), groups)
+    numpy = GtspLns(G, groups, 0, compiled=False)
+    ref = numpy._insert(keep.tolist(), nodes[: len(keep)].tolist(), removed.tolist())
     assert (o.tolist(), v.tolist()) == ref
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_compiled_search_finds_the_numpy_search_s_tour(seed: int) -> None:
+    G, groups, *_ = _instance(40, seed, ties=seed == 0)
+    settings = LnsSettings(max_iterations=120, patience=50, time_limit_s=600)
+    a = GtspLns(G, groups, seed, compiled=True).run(settings)
+    b = GtspLns(G, groups, seed, compiled=False).run(settings)
+    assert (a.nodes, a.cost_s, a.iterations) == (b.nodes, b.cost_s, b.iterations)
 
 
 def test_near_holes_are_the_nearest_by_the_least_node_to_node_cost() -> None:

@@ -6,18 +6,17 @@ import itertools
 
 import numpy as np
 import pytest
-from lns_reference import (
+
+from planner.costs import cost_matrix
+from planner.errors import PlanningError
+from planner.lns import GtspLns, LnsSettings, layered_nodes
+from planner.local_search import (
     apply_or_opt,
     apply_two_opt,
     best_or_opt,
     best_two_opt,
     improve_order,
-    layered_nodes,
 )
-
-from planner.costs import cost_matrix
-from planner.errors import PlanningError
-from planner.lns import GtspLns, LnsSettings
 from planner.sequence import layered_best, sequence, tour_cost
 from planner.timing import JointLimits
 

@@ -1,9 +1,4 @@
-"""The numpy reference of the GTSP search's compiled kernels (:mod:`planner.lns_kernel`).
-
-These are the search's loops as they were written in numpy before they were compiled:
-the kernels must give the same numbers, bit for bit (``test_planner_lns_kernel``).
-
-Order improvement with fixed configurations: 2-opt and or-opt, vectorised in numpy.
+"""Order improvement with fixed configurations: 2-opt and or-opt, vectorised in numpy.
 
 A tour is the path ``Q = [home, q_1, ..., q_n, home]`` (rad); ``C`` is its matrix of
 symmetric travel times (s). Moves keep both home ends in place and are applied
@@ -12,8 +7,6 @@ best-improvement first until none improves by more than ``EPS_S``.
 
 from __future__ import annotations
 
-import itertools
-from collections.abc import Sequence
 from functools import lru_cache
 
 import numpy as np
@@ -107,55 +100,3 @@ def improve_order(C: NDArray[np.float64], max_moves: int = 10_000) -> list[int]:
         perm = [perm[s] for s in step]
         cur = cur[np.ix_(step, step)]
     return perm
-
-
-def layered_nodes(
-    G: NDArray[np.floating],
-    layers: Sequence[NDArray[np.int64]],
-    spans: Sequence[tuple[int, int]] | None = None,
-) -> tuple[list[int], float]:
-    """Exact best node per layer for a fixed order of layers, home (node 0) at both ends.
-
-    ``spans`` (optional): ``(first, end)`` of each layer when it is the contiguous range
-    ``first .. end-1`` of nodes (then the blocks of ``G`` are read as views, not copies:
-    the same numbers, a third of the time)."""
-    if not layers:
-        return [], 0.0
-    blocks = (
-        [G[a0:a1, b0:b1] for (a0, a1), (b0, b1) in itertools.pairwise(spans)]
-        if spans is not None
-        else [G[prev[:, None], cur[None, :]] for prev, cur in itertools.pairwise(layers)]
-    )
-    dist = G[0, layers[0]].astype(float)
-    back = []
-    for block in blocks:
-        total = dist[:, None] + block
-        back.append(np.argmin(total, axis=0))
-        dist = total.min(axis=0)
-    total = dist + G[layers[-1], 0]
-    pick = [int(np.argmin(total))]
-    cost = float(total[pick[0]])
-    for arg in reversed(back):
-        pick.append(int(arg[pick[-1]]))
-    pick.reverse()
-    return [int(layer[p]) for layer, p in zip(layers, pick, strict=True)], cost
-
-
-def insert_reference(
-    G: NDArray[np.floating],
-    order: list[int],
-    nodes: list[int],
-    removed: list[int],
-    groups: Sequence[NDArray[np.int64]],
-) -> tuple[list[int], list[int]]:
-    """Each removed hole, in turn, at its cheapest position with its cheapest node."""
-    order, nodes = list(order), list(nodes)
-    for h in removed:
-        path = np.array([0, *nodes, 0])
-        cand = groups[h]
-        into, out = G[np.ix_(path[:-1], cand)], G[np.ix_(cand, path[1:])].T
-        extra = into + out - G[path[:-1], path[1:]][:, None]
-        e, c = divmod(int(np.argmin(extra)), extra.shape[1])
-        order.insert(e, h)
-        nodes.insert(e, int(cand[c]))
-    return order, nodes
