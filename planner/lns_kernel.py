@@ -121,15 +121,16 @@ def layered(
     for li in range(1, n):
         b0 = goff[order[li]]
         kb = goff[order[li] + 1] - b0
-        for b in range(kb):
-            vb = gnodes[b0 + b]
-            best, arg = np.inf, 0
-            for a in range(ka):
-                t = dist[a] + G[gnodes[a0 + a], vb]
-                if t < best:
-                    best, arg = t, a
-            new[b] = best
-            back[li, b] = arg
+        new[:kb] = np.inf
+        back[li, :kb] = 0
+        for a in range(ka):  # rows of G, read along: the first a with the least total wins
+            row = gnodes[a0 + a]
+            da = dist[a]
+            for b in range(kb):
+                t = da + G[row, gnodes[b0 + b]]
+                if t < new[b]:
+                    new[b] = t
+                    back[li, b] = a
         dist[:kb] = new[:kb]
         a0, ka = b0, kb
     best, pick = np.inf, 0

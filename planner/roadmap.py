@@ -53,35 +53,29 @@ class Roadmap:
         return self.__dict__ | {"_rows": {}, "_weights": None}
 
     def shortest_from(
-        self, graph: csr_matrix, sources: NDArray[np.int64]
-    ) -> tuple[NDArray[np.float64], NDArray[np.int32]]:
-        """Dijkstra's distances (s) and predecessors from each of ``sources`` over ``graph``
-        (:meth:`graph`), one row per source; rows already computed for the same weights are
-        reused (the same numbers: each row depends on its source only)."""
-        if self._weights is None or not np.array_equal(self._weights, graph.data):
-            self._rows, self._weights = {}, graph.data.copy()
-        todo = [int(s) for s in sources if int(s) not in self._rows]
-        if todo:
-            dist, pred = dijkstra(graph, directed=False, indices=todo, return_predecessors=True)
-            self._rows.update(zip(todo, zip(dist, pred, strict=True), strict=True))
-        rows = [self._rows[int(s)] for s in sources]
-        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
-
-    def graph(self, G: NDArray[np.float64]) -> csr_matrix | None:
-        """The free motions as a sparse graph weighted by the current ``G`` (s), or None.
-
-        The free motions' index arrays are made once (``free`` is filled once by
-        :func:`build_roadmap`; made again if its number of entries changed); the weights are
-        read from ``G`` at each call (learned costs change it).
-        """
+        self, G: NDArray[np.float64], sources: list[int]
+    ) -> list[tuple[NDArray[np.float64], NDArray[np.int32]]] | None:
+        """Dijkstra's distances (s) and predecessors from each of ``sources`` over the free
+        motions weighted by the current ``G`` (None: no free motion). Rows already computed
+        for the same weights are reused (the same numbers: a row depends on its source and
+        the weights only)."""
         if self._edges is None or self._edges[0] != len(self.free):
             e = np.array([uv for uv, f in self.free.items() if f], dtype=np.int64).reshape(-1, 2)
             self._edges = (len(self.free), e[:, 0], e[:, 1])
+            self._weights = None
         _, u, v = self._edges
         if not len(u):
             return None
-        N = G.shape[0]
-        return csr_matrix((np.maximum(G[u, v], 1e-9), (u, v)), shape=(N, N))
+        weights = np.maximum(G[u, v], 1e-9)
+        if self._weights is None or not np.array_equal(self._weights, weights):
+            self._rows, self._weights = {}, weights
+        todo = [s for s in sources if s not in self._rows]
+        if todo:
+            N = G.shape[0]
+            graph = csr_matrix((weights, (u, v)), shape=(N, N))
+            dist, pred = dijkstra(graph, directed=False, indices=todo, return_predecessors=True)
+            self._rows.update(zip(todo, zip(dist, pred, strict=True), strict=True))
+        return [self._rows[s] for s in sources]
 
     def via(self, u: int, v: int) -> list[int] | None:
         """Intermediate nodes of the roadmap detour from ``u`` to ``v`` (None: none known)."""
@@ -136,17 +130,18 @@ def detour_costs(
     uv = np.array(blocked, dtype=np.int64).reshape(-1, 2)
     u, v = uv[:, 0], uv[:, 1]
     cost = DETOUR_FACTOR * G[u, v] + DETOUR_EXTRA_S
-    graph = rm.graph(G)
-    if graph is not None:
-        sources, rows = np.unique(u, return_inverse=True)
-        dist, pred = rm.shortest_from(graph, sources)
-        d = dist[rows, v]
-        found = np.flatnonzero(np.isfinite(d))
-        cost[found] = np.maximum(d[found], G[u[found], v[found]])
-        for i in found.tolist():
-            a, x, row, path = int(u[i]), int(v[i]), pred[rows[i]], []
+    sources = sorted(set(u.tolist()))
+    found = rm.shortest_from(G, sources)
+    if found is not None:
+        row = dict(zip(sources, found, strict=True))
+        for i, (a, b) in enumerate(uv.tolist()):
+            dist, pred = row[a]
+            if not np.isfinite(dist[b]):
+                continue
+            cost[i] = max(float(dist[b]), float(G[a, b]))
+            path, x = [], b
             while x != a:
-                x = int(row[x])
+                x = int(pred[x])
                 path.append(x)
-            rm.detours[(a, int(v[i]))] = path[::-1][1:]
+            rm.detours[(a, b)] = path[::-1][1:]
     return dict(zip(map(tuple, uv.tolist()), cost.tolist(), strict=True))
