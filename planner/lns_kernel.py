@@ -63,6 +63,34 @@ def _or_opt(
 
 
 @njit(cache=True)
+def _apply(
+    p: NDArray[np.int64], kind: int, i: int, j: int, length: int, rev: bool
+) -> NDArray[np.int64]:
+    """``p`` after a 2-opt move (kind 0: reverse ``p[i+1 .. j]``) or an or-opt move (kind 1:
+    ``p[i .. i+length-1]``, maybe reversed, to between positions j and j+1)."""
+    if kind == 0:
+        p[i + 1 : j + 1] = p[i + 1 : j + 1][::-1].copy()
+        return p
+    seg = p[i : i + length].copy()
+    if rev:
+        seg = seg[::-1].copy()
+    rest = np.concatenate((p[:i], p[i + length :]))
+    at = j + 1 if j < i else j + 1 - length
+    return np.concatenate((rest[:at], seg, rest[at:]))
+
+
+@njit(cache=True)
+def _insert_at(
+    o: NDArray[np.int64], v: NDArray[np.int64], k: int, e: int, h: int, node: int
+) -> None:
+    """Insert hole ``h`` with ``node`` at position ``e`` of the first ``k`` entries."""
+    o[e + 1 : k + 1] = o[e:k].copy()
+    v[e + 1 : k + 1] = v[e:k].copy()
+    o[e] = h
+    v[e] = node
+
+
+@njit(cache=True)
 def improve_path(
     G: NDArray[np.float64], path: NDArray[np.int64], max_moves: int
 ) -> NDArray[np.int64]:
@@ -83,15 +111,7 @@ def improve_path(
                 d, i, j, kind, length, rev = d2, i2, j2, 1, ln, r2
         if not d < -EPS_S:
             break
-        if kind == 0:
-            p[i + 1 : j + 1] = p[i + 1 : j + 1][::-1].copy()
-            continue
-        seg = p[i : i + length].copy()
-        if rev:
-            seg = seg[::-1].copy()
-        rest = np.concatenate((p[:i], p[i + length :]))
-        at = j + 1 if j < i else j + 1 - length
-        p = np.concatenate((rest[:at], seg, rest[at:]))
+        p = _apply(p, kind, i, j, length, rev)
     return p
 
 
@@ -171,10 +191,7 @@ def insert(
                 x = G[a, gnodes[c]] + G[gnodes[c], b] - edge
                 if x < best:
                     best, be, bc = x, e, c
-        o[be + 1 : k + 1] = o[be:k].copy()
-        v[be + 1 : k + 1] = v[be:k].copy()
-        o[be] = h
-        v[be] = gnodes[bc]
+        _insert_at(o, v, k, be, h, gnodes[bc])
         k += 1
     return o, v
 
@@ -280,18 +297,11 @@ def improve_path_near(
             continue
         moves += 1
         if kind == 0:
-            ends = (bi, bi + 1, bj, bj + 1)
-            touched = np.array([p[k] for k in ends])
-            p[bi + 1 : bj + 1] = p[bi + 1 : bj + 1][::-1].copy()
+            touched = np.array([p[bi], p[bi + 1], p[bj], p[bj + 1]])
         else:
             e = bi + blen - 1
             touched = np.array([p[bi - 1], p[bi], p[e], p[e + 1], p[bj], p[bj + 1]])
-            seg = p[bi : bi + blen].copy()
-            if brev:
-                seg = seg[::-1].copy()
-            rest = np.concatenate((p[:bi], p[bi + blen :]))
-            at = bj + 1 if bj < bi else bj + 1 - blen
-            p = np.concatenate((rest[:at], seg, rest[at:]))
+        p = _apply(p, kind, bi, bj, blen, brev)
         pos = _positions(p, order, holes)
         for q in touched:
             if 1 <= q <= n - 2 and not queued[order[q - 1]]:
@@ -351,10 +361,7 @@ def insert_near(
                 x2 = G[a, gnodes[c]] + G[b, gnodes[c]] - edge
                 if x2 < best:
                     best, be, bc = x2, e, c
-        o[be + 1 : k + 1] = o[be:k].copy()
-        v[be + 1 : k + 1] = v[be:k].copy()
-        o[be] = h
-        v[be] = gnodes[bc]
+        _insert_at(o, v, k, be, h, gnodes[bc])
         k += 1
         for i in range(be, k):
             pos[o[i]] = i
