@@ -66,6 +66,19 @@ PROBE_COARSENESS = 48.0
 CORRIDOR = 3
 
 
+def _arcs(tours: list, n_nodes: int) -> NDArray[np.int64]:
+    """The distinct motions (u, v) of node lists ``tours`` (or of (k, 2) arrays of motions),
+    in sorted order, as a (m, 2) array."""
+    pairs = [
+        np.asarray(t).reshape(-1, 2)
+        if np.ndim(t) == 2
+        else np.column_stack([np.asarray(t)[:-1], np.asarray(t)[1:]])
+        for t in tours
+    ]
+    code = np.unique(np.concatenate(pairs).astype(np.int64) @ np.array([n_nodes, 1]))
+    return np.column_stack([code // n_nodes, code % n_nodes])
+
+
 class LazyEdgeChecks:
     """The lazy rounds of :class:`planner.planner.TourPlanner` (state set up per start by
     its ``_sequence_and_paths``: the roadmap, the known motions, the batch checkers)."""
@@ -119,8 +132,10 @@ class LazyEdgeChecks:
         :meth:`_avoid_colliding_edges`), learn the detour cost of every colliding one; True
         when the tour itself had a colliding motion whose cost was not a detour's yet."""
         tours = [[0, *t, 0] for t in (nodes, *seen)]
-        keys = {(min(u, v), max(u, v)) for t in tours for u, v in itertools.pairwise(t)}
-        todo = sorted(k for k in keys if k not in self._edge_free and k not in self._coarse_free)
+        arcs = _arcs(tours, len(seqr.nodes))  # every motion of the tours, (u, v) sorted
+        keys = _arcs([np.sort(arcs, axis=1)], len(seqr.nodes))  # as (min, max), sorted
+        todo = [k for k in map(tuple, keys.tolist()) if k not in self._edge_free]
+        todo = [k for k in todo if k not in self._coarse_free]
         if todo:
             free = self._free(self._coarse_batch, seqr, todo, checker)
             for key, f in zip(todo, free.tolist(), strict=True):
@@ -135,15 +150,11 @@ class LazyEdgeChecks:
             if todo:
                 free = self._free(self._batch, seqr, todo, checker)
                 self._edge_free.update(zip(todo, free.tolist(), strict=True))
-        blocked = sorted(
-            {
-                (u, v)
-                for t in tours
-                for u, v in itertools.pairwise(t)
-                if self._edge_free.get((min(u, v), max(u, v))) is False
-                and (u, v) not in seqr.learned
-            }
-        )
+        blocked = [
+            (u, v)
+            for u, v in map(tuple, arcs.tolist())
+            if self._edge_free.get((min(u, v), max(u, v))) is False and (u, v) not in seqr.learned
+        ]
         on_tour = set(itertools.pairwise(path))
         if blocked:
             seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
