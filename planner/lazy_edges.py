@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import itertools
 import time
+from collections.abc import Iterator
 
 import numpy as np
 from numpy.typing import NDArray
@@ -66,17 +67,24 @@ PROBE_COARSENESS = 48.0
 CORRIDOR = 3
 
 
-def _arcs(tours: list, n_nodes: int) -> NDArray[np.int64]:
-    """The distinct motions (u, v) of node lists ``tours`` (or of (k, 2) arrays of motions),
-    in sorted order, as a (m, 2) array."""
-    pairs = [
-        np.asarray(t).reshape(-1, 2)
-        if np.ndim(t) == 2
-        else np.column_stack([np.asarray(t)[:-1], np.asarray(t)[1:]])
-        for t in tours
-    ]
-    code = np.unique(np.concatenate(pairs).astype(np.int64) @ np.array([n_nodes, 1]))
+def _distinct(pairs: NDArray[np.int64], n_nodes: int) -> NDArray[np.int64]:
+    """The distinct rows of a (m, 2) array of node pairs, in sorted order."""
+    code = np.unique(pairs.astype(np.int64) @ np.array([n_nodes, 1]))
     return np.column_stack([code // n_nodes, code % n_nodes])
+
+
+def _cheaper_motions(
+    seqr: GtspSequencer, a: int, b: int, below_s: float
+) -> Iterator[tuple[int, int]]:
+    """The motions between the nodes of groups ``a`` and ``b`` (0: home, h + 1: hole h) that
+    cost less than ``below_s`` (s), cheapest first (ties: row-major), as (min, max) pairs."""
+    ga, gb = (np.array([0]) if g == 0 else seqr.groups[g - 1] for g in (a, b))
+    C = seqr.G[np.ix_(ga, gb)]
+    order = np.argsort(C, axis=None, kind="stable")
+    for f in order[C.ravel()[order] < below_s].tolist():
+        i, j = divmod(f, len(gb))
+        x, y = int(ga[i]), int(gb[j])
+        yield (min(x, y), max(x, y))
 
 
 class LazyEdgeChecks:
@@ -131,9 +139,10 @@ class LazyEdgeChecks:
         """Check the unknown motions of the tour ``nodes`` and of the ``seen`` tours (see
         :meth:`_avoid_colliding_edges`), learn the detour cost of every colliding one; True
         when the tour itself had a colliding motion whose cost was not a detour's yet."""
-        tours = [[0, *t, 0] for t in (nodes, *seen)]
-        arcs = _arcs(tours, len(seqr.nodes))  # every motion of the tours, (u, v) sorted
-        keys = _arcs([np.sort(arcs, axis=1)], len(seqr.nodes))  # as (min, max), sorted
+        tours = [np.array([0, *t, 0]) for t in (nodes, *seen)]
+        N = len(seqr.nodes)
+        arcs = _distinct(np.concatenate([np.column_stack([t[:-1], t[1:]]) for t in tours]), N)
+        keys = _distinct(np.sort(arcs, axis=1), N)  # the motions as (min, max)
         todo = [k for k in map(tuple, keys.tolist()) if k not in self._edge_free]
         todo = [k for k in todo if k not in self._coarse_free]
         if todo:
@@ -143,7 +152,7 @@ class LazyEdgeChecks:
                     self._coarse_free.add(key)
                 else:
                     self._edge_free[key] = False
-        path = tours[0]
+        path = tours[0].tolist()
         fine = sorted({(min(u, v), max(u, v)) for u, v in itertools.pairwise(path)})
         if not any(self._edge_free.get(key) is False for key in fine):
             todo = [key for key in fine if key not in self._edge_free]
@@ -171,7 +180,6 @@ class LazyEdgeChecks:
         """Probe the corridor of each colliding tour motion (see ``CORRIDOR``) in one batch;
         the colliding probes are learned (a free probe proves nothing)."""
         near = seqr.near_holes()[:, :CORRIDOR]
-        group = [np.array([0]), *seqr.groups]
         keys: set[tuple[int, int]] = set()
         for u, v in hit:
             a, b = int(seqr.owner[u]) + 1, int(seqr.owner[v]) + 1
@@ -182,14 +190,8 @@ class LazyEdgeChecks:
             for a2, b2 in itertools.product(ends_a, ends_b):
                 if a2 == b2 or (a2, b2) == (a, b) or (a2, b2) == (b, a):
                     continue
-                ga, gb = group[a2], group[b2]
-                C = seqr.G[np.ix_(ga, gb)]
-                order = np.argsort(C, axis=None, kind="stable")
-                order = order[C.ravel()[order] < seqr.G[u, v]]
                 found = 0
-                for f in order.tolist():
-                    i, j = divmod(f, len(gb))
-                    key = (min(int(ga[i]), int(gb[j])), max(int(ga[i]), int(gb[j])))
+                for key in _cheaper_motions(seqr, a2, b2, seqr.G[u, v]):
                     if key in self._edge_free or key in self._coarse_free or key in keys:
                         continue
                     keys.add(key)
@@ -215,15 +217,11 @@ class LazyEdgeChecks:
         checked coarse in one batch, the colliding ones learned (the next search would try
         them one by one); while all of a batch collide (an obstacle between the two holes),
         the next twice as many."""
-        group = [np.array([0]), *seqr.groups]
         queue = {}
         for u, v in hit:
-            a, b = group[int(seqr.owner[u]) + 1], group[int(seqr.owner[v]) + 1]
-            C = seqr.G[np.ix_(a, b)]
-            order = np.argsort(C, axis=None, kind="stable")
-            pairs = [divmod(int(f), len(b)) for f in order[C.ravel()[order] < seqr.G[u, v]]]
-            keys = [(min(int(a[i]), int(b[j])), max(int(a[i]), int(b[j]))) for i, j in pairs]
-            queue[(u, v)] = [k for k in keys if k not in self._edge_free]
+            a, b = int(seqr.owner[u]) + 1, int(seqr.owner[v]) + 1
+            motions = _cheaper_motions(seqr, a, b, seqr.G[u, v])
+            queue[(u, v)] = [k for k in motions if k not in self._edge_free]
         size = SIBLINGS
         grow = len(hit) >= CLUTTERED_HITS
         while queue and (grow or size == SIBLINGS):
