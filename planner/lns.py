@@ -41,7 +41,7 @@ MAX_MOVES = 10_000
 #: per process costs more than it saves (the frame: 41 holes)
 COMPILED_ABOVE = 60
 #: above this many holes, moves and insertions only join a hole to one of its ``NEAR_K``
-#: nearest holes (:mod:`planner.lns_kernel`); up to it, every move is scanned
+#: nearest holes (:mod:`planner.lns_near`); up to it, every move is scanned
 NEAR_ABOVE = 120
 NEAR_K = 8
 
@@ -139,9 +139,10 @@ class GtspLns:
         self.k = None
         self.near = None
         if len(self.groups) > COMPILED_ABOVE if compiled is None else compiled:
-            from planner import lns_kernel  # Numba: loaded only where it pays
+            from planner import lns_kernel, lns_near  # Numba: loaded only where it pays
 
             self.k = lns_kernel
+            self.kn = lns_near
             self.G = np.ascontiguousarray(G, dtype=np.float64)  # no copy of the planner's
             self.gnodes = np.concatenate([np.zeros(0, dtype=np.int64), *self.groups])
             self.goff = np.cumsum([0] + [len(g) for g in self.groups]).astype(np.int64)
@@ -172,7 +173,7 @@ class GtspLns:
                 perm = self.k.improve_path(self.G, np.array(path), MAX_MOVES).tolist()
             else:
                 holes = np.array(order, dtype=np.int64)
-                perm = self.k.improve_path_near(
+                perm = self.kn.improve_path_near(
                     self.G, np.array(path), holes, self.near, MAX_MOVES
                 ).tolist()
             inner = [p - 1 for p in perm[1:-1]]
@@ -220,7 +221,7 @@ class GtspLns:
             args = (self.G, np.array(order), np.array(nodes), np.array(removed))
             args += (self.gnodes, self.goff)
             o, v = (
-                self.k.insert(*args) if self.near is None else self.k.insert_near(*args, self.near)
+                self.k.insert(*args) if self.near is None else self.kn.insert_near(*args, self.near)
             )
             return o.tolist(), v.tolist()
         for h in removed:

@@ -1,7 +1,7 @@
 """The inner loops of the GTSP search (:mod:`planner.lns`), compiled by Numba.
 
-Every function here is the scalar form of a numpy expression that the search used
-before (kept in :mod:`planner.local_search` and in the tests as the reference): the
+Every full-scan function here is the scalar form of a numpy expression of the search
+(:mod:`planner.lns` and :mod:`planner.local_search`, which run up to 60 holes): the
 same arithmetic in the same order, and ties broken the same way (the first minimum in
 row-major order, as ``np.argmin``), so the tours are the same, bit for bit. What
 changes is the cost: no temporary matrices and no Python loop over the tour's layers.
@@ -10,7 +10,8 @@ changes is the cost: no temporary matrices and no Python loop over the tour's la
 (node 0) at both ends; a hole's nodes are ``gnodes[goff[h]:goff[h + 1]]``.
 
 Compiled on first use and cached beside this file (``cache=True``): a fresh process
-loads the machine code instead of compiling again.
+loads the machine code instead of compiling again. The move deltas and appliers are
+shared with the neighbour moves of large tours (:mod:`planner.lns_near`).
 """
 
 from __future__ import annotations
@@ -24,14 +25,38 @@ EPS_S = 1e-9
 
 
 @njit(cache=True)
+def two_opt_delta(C: NDArray[np.float64], p: NDArray[np.int64], i: int, j: int) -> float:
+    """Change (s) of reversing ``p[i+1 .. j]``: edges (i, j) and (i+1, j+1) replace
+    (i, i+1) and (j, j+1)."""
+    return C[p[i], p[j]] + C[p[i + 1], p[j + 1]] - C[p[i], p[i + 1]] - C[p[j], p[j + 1]]
+
+
+@njit(cache=True)
+def segment_removal(C: NDArray[np.float64], p: NDArray[np.int64], s: int, e: int) -> float:
+    """Change (s) of taking the segment ``p[s .. e]`` out (its neighbours joined)."""
+    return C[p[s - 1], p[e + 1]] - C[p[s - 1], p[s]] - C[p[e], p[e + 1]]
+
+
+@njit(cache=True)
+def or_opt_delta(
+    C: NDArray[np.float64], p: NDArray[np.int64], s: int, e: int, t: int, removal: float
+) -> tuple[float, bool]:
+    """Change (s) of moving the segment ``p[s .. e]`` (its :func:`segment_removal` given) into the
+    edge (t, t+1), the better way round, and whether reversed."""
+    base = removal - C[p[t], p[t + 1]]
+    fwd = C[p[s], p[t]] + C[p[e], p[t + 1]] + base
+    rev = C[p[e], p[t]] + C[p[s], p[t + 1]] + base
+    return min(fwd, rev), rev < fwd
+
+
+@njit(cache=True)
 def _two_opt(C: NDArray[np.float64], p: NDArray[np.int64]) -> tuple[float, int, int]:
     """Best 2-opt move on the path ``p`` of ``C``: reverse ``p[i+1 .. j]`` (delta_s, i, j)."""
     m = p.shape[0] - 1
     best, bi, bj = np.inf, 0, 0
     for i in range(m):
-        ei = C[p[i], p[i + 1]]
         for j in range(i + 2, m):
-            d = C[p[i], p[j]] + C[p[i + 1], p[j + 1]] - ei - C[p[j], p[j + 1]]
+            d = two_opt_delta(C, p, i, j)
             if d < best:
                 best, bi, bj = d, i, j
     return best, bi, bj
@@ -49,21 +74,18 @@ def _or_opt(
     best, bs, bj, brev = np.inf, 1, 0, False
     for s in range(1, m - length + 1):
         e = s + length - 1
-        removal = C[p[s - 1], p[e + 1]] - C[p[s - 1], p[s]] - C[p[e], p[e + 1]]
+        removal = segment_removal(C, p, s, e)
         for j in range(m):
             if s - 1 <= j <= e:
                 continue
-            base = removal - C[p[j], p[j + 1]]
-            fwd = C[p[s], p[j]] + C[p[e], p[j + 1]] + base
-            rev = C[p[e], p[j]] + C[p[s], p[j + 1]] + base
-            d = min(fwd, rev)
+            d, rev = or_opt_delta(C, p, s, e, j, removal)
             if d < best:
-                best, bs, bj, brev = d, s, j, rev < fwd
+                best, bs, bj, brev = d, s, j, rev
     return best, bs, bj, brev
 
 
 @njit(cache=True)
-def _apply(
+def apply_move(
     p: NDArray[np.int64], kind: int, i: int, j: int, length: int, rev: bool
 ) -> NDArray[np.int64]:
     """``p`` after a 2-opt move (kind 0: reverse ``p[i+1 .. j]``) or an or-opt move (kind 1:
@@ -80,7 +102,7 @@ def _apply(
 
 
 @njit(cache=True)
-def _insert_at(
+def insert_at(
     o: NDArray[np.int64], v: NDArray[np.int64], k: int, e: int, h: int, node: int
 ) -> None:
     """Insert hole ``h`` with ``node`` at position ``e`` of the first ``k`` entries."""
@@ -111,7 +133,7 @@ def improve_path(
                 d, i, j, kind, length, rev = d2, i2, j2, 1, ln, r2
         if not d < -EPS_S:
             break
-        p = _apply(p, kind, i, j, length, rev)
+        p = apply_move(p, kind, i, j, length, rev)
     return p
 
 
@@ -191,180 +213,8 @@ def insert(
                 x = G[a, gnodes[c]] + G[gnodes[c], b] - edge
                 if x < best:
                     best, be, bc = x, e, c
-        _insert_at(o, v, k, be, h, gnodes[bc])
+        insert_at(o, v, k, be, h, gnodes[bc])
         k += 1
-    return o, v
-
-
-# --- large tours: moves between neighbouring holes only -------------------------------
-#
-# Above ``planner.lns.NEAR_ABOVE`` holes a full scan of every move costs O(n²) per move
-# and finds little that the neighbour moves miss (the standard candidate-list technique
-# of TSP local search): the moves below only join a hole to one of its ``K`` nearest
-# holes (``near[h]``, hole indices), in O(n K) per move. ``order`` is the hole order of
-# ``path`` (``path[1 + i]`` is a node of hole ``order[i]``).
-
-
-@njit(cache=True)
-def _positions(p: NDArray[np.int64], order: NDArray[np.int64], holes: int) -> NDArray[np.int64]:
-    """Current path position of each hole (-1: not on the path)."""
-    pos = np.full(holes, -1, dtype=np.int64)
-    for i in range(1, p.shape[0] - 1):
-        pos[order[p[i] - 1]] = i
-    return pos
-
-
-@njit(cache=True)
-def _best_near_move(
-    C: NDArray[np.float64],
-    p: NDArray[np.int64],
-    pos: NDArray[np.int64],
-    i: int,
-    near_h: NDArray[np.int64],
-) -> tuple[float, int, int, int, int, bool]:
-    """The best move joining the hole at position ``i`` to one of ``near_h``: 2-opt moves
-    whose new edges include that pair, or-opt moves of a segment ending at ``i`` to either
-    side of the neighbour (delta_s, kind 0/1, i, j, length, reversed)."""
-    m = p.shape[0] - 1
-    best, kind, bi, bj, blen, brev = -EPS_S, -1, 0, 0, 0, False
-    for x in near_h:
-        j = pos[x]
-        if j < 0:
-            continue
-        a, b = min(i, j), max(i, j)
-        if b >= a + 2:  # new edges (a, b) and (a+1, b+1), or (a-1, b-1) and (a, b)
-            for s in (a, a - 1):
-                t = s + b - a
-                if s < 0 or t >= m:
-                    continue
-                d = C[p[s], p[t]] + C[p[s + 1], p[t + 1]] - C[p[s], p[s + 1]] - C[p[t], p[t + 1]]
-                if d < best:
-                    best, kind, bi, bj = d, 0, s, t
-        for length in (1, 2, 3):
-            if m - length < 1:
-                continue
-            for s in (i, i - length + 1):
-                e = s + length - 1
-                if s < 1 or s > m - length:
-                    continue
-                removal = C[p[s - 1], p[e + 1]] - C[p[s - 1], p[s]] - C[p[e], p[e + 1]]
-                for t in (j - 1, j):
-                    if t < 0 or t >= m or s - 1 <= t <= e:
-                        continue
-                    base = removal - C[p[t], p[t + 1]]
-                    fwd = C[p[s], p[t]] + C[p[e], p[t + 1]] + base
-                    rev = C[p[e], p[t]] + C[p[s], p[t + 1]] + base
-                    d = min(fwd, rev)
-                    if d < best:
-                        best, kind, bi, bj, blen, brev = d, 1, s, t, length, rev < fwd
-    return best, kind, bi, bj, blen, brev
-
-
-@njit(cache=True)
-def improve_path_near(
-    G: NDArray[np.float64],
-    path: NDArray[np.int64],
-    order: NDArray[np.int64],
-    near: NDArray[np.int64],
-    max_moves: int,
-) -> NDArray[np.int64]:
-    """A local optimum of the neighbour moves (:func:`_best_near_move`) from the order of
-    ``path``: each hole in a queue (first all, in path order) applies its best improving
-    move; the holes at the ends of the edges a move changed join the queue again ("don't
-    look bits"). ``C`` must be symmetric. Returns the permutation of path positions."""
-    n = path.shape[0]
-    C = np.empty((n, n))
-    for a in range(n):
-        for b in range(n):
-            C[a, b] = G[path[a], path[b]]
-    p = np.arange(n)
-    holes = near.shape[0]
-    pos = _positions(p, order, holes)
-    queue = np.empty(n - 2 + 6 * max_moves, dtype=np.int64)
-    queued = np.zeros(holes, dtype=np.bool_)
-    tail = 0
-    for i in range(1, n - 1):
-        queue[tail] = order[i - 1]
-        queued[order[i - 1]] = True
-        tail += 1
-    head, moves = 0, 0
-    while head < tail and moves < max_moves:
-        h = queue[head]
-        head += 1
-        queued[h] = False
-        _d, kind, bi, bj, blen, brev = _best_near_move(C, p, pos, pos[h], near[h])
-        if kind < 0:
-            continue
-        moves += 1
-        if kind == 0:
-            touched = np.array([p[bi], p[bi + 1], p[bj], p[bj + 1]])
-        else:
-            e = bi + blen - 1
-            touched = np.array([p[bi - 1], p[bi], p[e], p[e + 1], p[bj], p[bj + 1]])
-        p = _apply(p, kind, bi, bj, blen, brev)
-        pos = _positions(p, order, holes)
-        for q in touched:
-            if 1 <= q <= n - 2 and not queued[order[q - 1]]:
-                queue[tail] = order[q - 1]
-                queued[order[q - 1]] = True
-                tail += 1
-    return p
-
-
-@njit(cache=True)
-def insert_near(
-    G: NDArray[np.float64],
-    order: NDArray[np.int64],
-    nodes: NDArray[np.int64],
-    removed: NDArray[np.int64],
-    gnodes: NDArray[np.int64],
-    goff: NDArray[np.int64],
-    near: NDArray[np.int64],
-) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """:func:`insert` trying only the positions beside a hole's neighbours on the tour
-    (every position when none of them is on it). ``G`` must be symmetric."""
-    holes = near.shape[0]
-    n = order.shape[0] + removed.shape[0]
-    o = np.empty(n, dtype=np.int64)
-    v = np.empty(n, dtype=np.int64)
-    k = order.shape[0]
-    o[:k] = order
-    v[:k] = nodes
-    pos = np.full(holes, -1, dtype=np.int64)
-    for i in range(k):
-        pos[o[i]] = i
-    tried = np.zeros(n + 1, dtype=np.bool_)
-    for h in removed:
-        best, be, bc = np.inf, -1, 0
-        tried[: k + 1] = False
-        cands = np.empty(2 * near.shape[1], dtype=np.int64)
-        nc = 0
-        for x in near[h]:
-            q = pos[x]
-            if q < 0:
-                continue
-            for e in (q, q + 1):
-                if not tried[e]:
-                    tried[e] = True
-                    cands[nc] = e
-                    nc += 1
-        if nc == 0:
-            cands = np.arange(k + 1)
-            nc = k + 1
-        cands[:nc].sort()
-        for ci in range(nc):
-            e = cands[ci]
-            a = 0 if e == 0 else v[e - 1]
-            b = 0 if e == k else v[e]
-            edge = G[a, b]
-            for c in range(goff[h], goff[h + 1]):
-                x2 = G[a, gnodes[c]] + G[b, gnodes[c]] - edge
-                if x2 < best:
-                    best, be, bc = x2, e, c
-        _insert_at(o, v, k, be, h, gnodes[bc])
-        k += 1
-        for i in range(be, k):
-            pos[o[i]] = i
     return o, v
 
 
@@ -380,6 +230,8 @@ def compile_kernels() -> None:
     holes = np.array([0, 1, 2], dtype=np.int64)
     near = np.array([[1, 2], [0, 2], [0, 1]], dtype=np.int64)
     gnodes, goff = np.array([1, 2, 3], dtype=np.int64), np.array([0, 1, 2, 3], dtype=np.int64)
+    from planner.lns_near import improve_path_near, insert_near  # it imports this module
+
     improve_path(G, path, 1)
     improve_path_near(G, path, holes, near, 1)
     layered(G, holes, gnodes, goff)

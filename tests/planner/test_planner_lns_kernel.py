@@ -9,13 +9,8 @@ import numpy as np
 import pytest
 
 from planner.lns import NEAR_ABOVE, GtspLns, LnsSettings, layered_nodes, near_holes
-from planner.lns_kernel import (
-    improve_path,
-    improve_path_near,
-    insert,
-    insert_near,
-    layered,
-)
+from planner.lns_kernel import improve_path, insert, layered
+from planner.lns_near import improve_path_near, insert_near
 from planner.local_search import improve_order
 from planner.roadmap import Roadmap, detour_costs
 
