@@ -21,6 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError,
 from cell.config_checks import cell_problems
 from cell.config_mesh import MeshSpec
 from cell.errors import ConfigError
+from cell.gdt.datums import Alignment, Datum, Tolerances, gdt_problems
 from cell.holes_csv import read_holes_csv
 from cell.uncertainty.materials import (
     BUILTIN_MATERIALS,
@@ -170,6 +171,8 @@ class Hole(_Strict):
     normal: Vec3
     diameter: Positive
     tolerance: Positive | None = None
+    #: GD&T position and size tolerances (:mod:`cell.gdt.datums`, docs/gdt.md)
+    tolerances: Tolerances | None = None
 
     _unit_normal = field_validator("normal")(lambda cls, v: _unit(v))
 
@@ -193,6 +196,9 @@ class Part(_Strict):
     ) = None
     #: standard uncertainty of ``temperature_c`` (K)
     u_temperature_K: Annotated[float, Field(gt=0, le=10)] | None = None  # noqa: N815
+    #: datum features in precedence and the run's alignment (:mod:`cell.gdt.datums`)
+    datums: list[Datum] = []
+    alignment: Alignment | None = None
 
     _material = field_validator("material", mode="before")(lambda cls, v: material_field(v))
 
@@ -409,7 +415,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
     cfg._raw_text = text
     if cfg.part.holes_csv is not None:
         cfg = _with_csv_holes(cfg, source, source_path, text)
-    problems = cell_problems(cfg)
+    problems = gdt_problems(cfg) or cell_problems(cfg)
     if problems:
         raise ConfigError(source, problems)
     return cfg
