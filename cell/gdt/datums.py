@@ -137,6 +137,19 @@ def frame_problem(kinds: tuple[str, ...]) -> str | None:
     return f"datums of kinds {' | '.join(kinds) or '(none)'} make no complete frame ({known})"
 
 
+def without_drawing(data: dict[str, Any], tolerance_m: float | None = None) -> dict[str, Any]:
+    """A cell file's mapping without its datums, alignment and holes' ``tolerances`` (for a
+    subset of the built-in frame's holes, whose datum features it may have left out); each
+    hole then carries the old single ``tolerance_m`` (None: no tolerance). In place; returned."""
+    part = data.get("part", {})
+    part.pop("datums", None)
+    part.pop("alignment", None)
+    for h in part.get("holes", []):
+        if h.pop("tolerances", None) is not None and tolerance_m is not None:
+            h["tolerance"] = tolerance_m
+    return data
+
+
 def gdt_problems(cfg: CellConfig) -> list[Problem]:
     """Every problem of the datums and tolerances of ``cfg`` (field path, value, message)."""
     holes = {h.id for h in cfg.part.holes}
@@ -207,6 +220,14 @@ def _hole_problems(where: str, h: Any, datums: dict[str, Datum]) -> list[Problem
                     f"{where}.position.zone_diameter_m",
                     0.0,
                     "a zero zone needs MMC or LMC (zero positional tolerance)",
+                )
+            )
+        if p.material_condition != "RFS" and tol.size is None:
+            out.append(
+                (
+                    f"{where}.position.material_condition",
+                    p.material_condition,
+                    "MMC and LMC need the hole's size limits (tolerances.size)",
                 )
             )
         if not p.datums:

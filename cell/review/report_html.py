@@ -246,15 +246,17 @@ def _budget_table(results: list[HoleResult]) -> str:
 
 def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleResult],
                 planned: list[tuple[str, int, dict]], operator: str = "",
-                reference: list[tuple[float, Any]] | None = None) -> str:  # fmt: skip
+                reference: list[tuple[float, Any]] | None = None,
+                gdt_html: str = "") -> str:  # fmt: skip
     """The whole ``report.html`` document; ``reference``: (controller time s, readings degC)
-    of the reference-target observations, for the thermal plot."""
+    of the reference-target observations, for the thermal plot; ``gdt_html``: the alignment
+    and characteristics (:mod:`cell.gdt.html`), after the counts."""
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>Inspection report {escape(summ['cell'])}</title><style>{CSS}</style></head><body>",
         f"<h1>Inspection report: {escape(summ['cell'])}</h1>",
         _header(summ, info, operator, results),
-        "<h2>Result</h2>", _counts(summ),
+        "<h2>Result</h2>", _counts(summ), gdt_html,
         "<h2>Holes</h2>", _hole_table(results, planned),
         "<p class='note'>Position deviation: distance of the measured centre from the nominal in "
         "the plane perpendicular to the nominal axis. U: expanded uncertainty (k = 2) of the "

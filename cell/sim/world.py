@@ -83,7 +83,8 @@ class WorldOptions:
         drift: the drift generator's settings (None: ``robots.thermal.drift.default_settings``).
         position_sigma_m: standard deviation of each true hole centre from nominal, in the
             surface plane (m): the part as machined.
-        diameter_sigma_m: standard deviation of each true diameter from nominal (m).
+        diameter_sigma_m: standard deviation of each true diameter from nominal (m; from the
+            middle of its size limits where the cell gives them).
         seed: seed of the part errors and the sensor noise.
         repeatability_rp_m: the arm's ISO 9283 pose repeatability RP (m): every capture's TCP
             position scatters isotropically by ``RP / 3.616`` per axis (0: none).
@@ -147,13 +148,18 @@ class SimWorld:
 
     def _true_holes(self, rng: np.random.Generator) -> dict[str, TrueHole]:
         out: dict[str, TrueHole] = {}
+        # the machining process aims at the middle of a hole's size limits (cell.gdt)
+        sizes = {h.id: h.tolerances.size for h in self.cell.part.holes
+                 if h.tolerances is not None and h.tolerances.size is not None}  # fmt: skip
         for h in self.cell.holes_in_cell():
             n = np.asarray(h.normal, dtype=float)
             u = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
             u /= np.linalg.norm(u)
             v = np.cross(n, u)
             du, dv = rng.normal(0.0, self.options.position_sigma_m, 2)
-            dd = rng.normal(0.0, self.options.diameter_sigma_m)
+            size = sizes.get(h.id)
+            mid = 0.0 if size is None else (size.upper_m + size.lower_m) / 2.0
+            dd = mid + rng.normal(0.0, self.options.diameter_sigma_m)
             out[h.id] = TrueHole(
                 h.id, np.asarray(h.position_m, float) + du * u + dv * v, n, h.diameter_m + dd
             )
