@@ -23,7 +23,7 @@ from cell.uncertainty.calibration import (
     perturbed,
 )
 from cell.uncertainty.repeatability import sigma_per_axis_m
-from measure import StereoCalibration, head_frame
+from measure import StereoCalibration
 from measure.synth import RenderOptions, render_hole_pair, render_reference_pair
 from robots.transforms import invert
 
@@ -68,12 +68,13 @@ class SimCamera:
         self.world = world
         self.controller = controller
         self.stereo = stereo  # the calibration file: what the runner measures with
-        o = world.options
-        self.true_stereo = true_head(stereo, o.calibration_sigma_scale, o.seed)
-        self._rep_sigma_m = sigma_per_axis_m(o.repeatability_rp_m)
+        tr = world.truth
+        self.true_stereo = true_head(stereo, tr.calibration_sigma_scale, tr.seed)
+        self._rep_sigma_m = sigma_per_axis_m(tr.repeatability_rp_m)
+        self.geometry = world.true_geometry(stereo)
         self.missing = set(missing_holes)
         self.render = render or RenderOptions()
-        self._T_head_left = invert(head_frame(stereo))
+        self._T_head_left = self.geometry.T_tcp_left
         self._seed = seed
         self.captures = 0
         self.last_truth: CaptureTruth | None = None
@@ -93,7 +94,7 @@ class SimCamera:
         key = feature.id if feature is not None else "none"
         seed = (self._seed * 1_000_003 + zlib.crc32(key.encode())) & 0x7FFFFFFF
         if self._rep_sigma_m > 0:  # the arm's repeatability: this approach's scatter
-            rng = np.random.default_rng([self.world.options.seed, seed, self.captures])
+            rng = np.random.default_rng([self.world.truth.seed, seed, self.captures])
             T_cell_tcp = T_cell_tcp.copy()
             T_cell_tcp[:3, 3] += rng.normal(0.0, self._rep_sigma_m, 3)
         T_cell_left = T_cell_tcp @ self._T_head_left
