@@ -126,7 +126,7 @@ class SimWorld:
         self.T_cell_base = np.asarray(cell.T_cell_base(), dtype=float) @ tr.base_error
         self.T_tool0_tcp = np.asarray(cell.T_tool0_tcp(), dtype=float) @ tr.tcp_error
         self.T_cell_part = np.asarray(cell.T_cell_part(), dtype=float) @ tr.part_placement_error
-        target = getattr(cell, "calibration_target", None)
+        target = cell.calibration_target
         self.T_cell_target = (None if target is None
                               else target.T_cell_target() @ tr.target_placement_error)  # fmt: skip
         settings = self.options.drift or default_settings()
