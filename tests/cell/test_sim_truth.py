@@ -171,3 +171,34 @@ def test_world_applies_each_error(cell) -> None:
             w.holes[h.id].position_m, T[:3, :3] @ h.position + T[:3, 3], atol=1e-12
         )
     assert w.truth.seed == w.options.seed == 0
+
+
+def test_demo_world_takes_the_truth(cell) -> None:
+    from cell.run.demo import DemoOptions, demo_truth, demo_world
+
+    t = CellTruth.drawn(8, cell)
+    assert demo_world(cell, DemoOptions(truth=t)).truth is t
+    assert demo_truth(cell, DemoOptions(truth=t, part_temperature_c=21.0)).part_temperature_c == 21
+    ideal = demo_truth(cell, DemoOptions(realistic=False, seed=4))
+    assert ideal.is_geometrically_zero() and ideal.repeatability_rp_m == 0.0
+    assert ideal.seed == 4 and ideal.part_temperature_c == 23.0
+    today = demo_truth(cell, DemoOptions())  # no truth file: the errors the demo had before
+    assert today.is_geometrically_zero() and today.calibration_sigma_scale == 1.0
+    assert today.repeatability_rp_m > 0
+    assert not t.is_geometrically_zero()
+
+
+def test_demo_refuses_ideal_with_a_truth(tmp_path: Path, capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["demo", "--ideal", "--truth", str(tmp_path / "t.yaml"), "--quiet"])
+    assert exc.value.code == 2 and "not allowed with" in capsys.readouterr().err
+
+
+def test_the_documented_truth_file_reads(tmp_path: Path) -> None:
+    doc = (Path(__file__).parents[2] / "docs" / "calibration.md").read_text()
+    text = doc.split("## The simulated truth", 1)[1].split("```yaml\n", 1)[1].split("```", 1)[0]
+    p = tmp_path / "truth.yaml"
+    p.write_text(text)
+    t = CellTruth.load(p)
+    assert t.seed == 3 and t.dh_errors[0, 0] == -2.8e-4 and t.part_temperature_c == 22.5
+    np.testing.assert_array_equal(t.dh_errors[1:], CellTruth.drawn(3).dh_errors[1:])
