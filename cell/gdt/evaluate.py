@@ -47,12 +47,13 @@ class Evaluation:
     characteristics: list[dict[str, Any]]
     alignment: str
     frames: dict[str, tuple[Frames, Frames]] = field(default_factory=dict, repr=False)
+    reason: str = ""
 
     def fields(self) -> dict[str, Any]:
         """The mapping added to report.json."""
-        return {"alignment": self.alignment, "datum_reference_frames": self.datum_reference_frames,
-                "datums": self.datums, "placement": self.placement,
-                "characteristics": self.characteristics}  # fmt: skip
+        return {"alignment": self.alignment, "gdt_reason": self.reason,
+                "datum_reference_frames": self.datum_reference_frames, "datums": self.datums,
+                "placement": self.placement, "characteristics": self.characteristics}  # fmt: skip
 
 
 def _pose(R: np.ndarray, t: np.ndarray) -> dict[str, list[float]]:

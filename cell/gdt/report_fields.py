@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from pydantic import ValidationError
 
 from cell.config import CellConfig, _with_csv_holes
 from cell.errors import ConfigError
@@ -112,7 +113,11 @@ def report_evaluation(info: dict[str, Any], results: list[HoleResult], rows: lis
                       summ: dict[str, Any]) -> tuple[Evaluation, list[HoleResult]]:  # fmt: skip
     """Evaluate a run for its report: the evaluation, with ``rows`` and ``summ`` updated in
     place, and the results with the same per-hole fields (for report.html's hole table)."""
-    cell = run_cell(info)
+    try:
+        cell = run_cell(info)
+    except (ValidationError, yaml.YAMLError, TypeError, KeyError) as exc:
+        why = f"the run's stored cell file is not a readable cell file ({str(exc).splitlines()[0]})"
+        return Evaluation([], [], None, [], FIXTURE, reason=why), results
     ev = evaluate(cell, results)
     apply_to_rows(ev, rows)
     apply_to_summary(ev, rows, summ)

@@ -14,9 +14,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from cell.config import CellConfig
-from cell.gdt.evaluate import evaluate
+from cell.gdt.evaluate import Evaluation, evaluate
 from cell.gdt.montecarlo import McOptions
 from cell.run.results import HoleResult
 
@@ -58,12 +59,17 @@ def true_results(cell: CellConfig, true_centres_part_m: dict[str, np.ndarray],
     return out
 
 
-def coverage(cell: CellConfig, reported: list[dict[str, Any]],
-             true_centres_part_m: dict[str, np.ndarray],
-             true_diameters_m: dict[str, float]) -> Coverage:  # fmt: skip
-    """Compare report.json's ``characteristics`` with the true part's."""
-    truth = evaluate(cell, true_results(cell, true_centres_part_m, true_diameters_m),
-                     McOptions(n_draws=2))  # fmt: skip
+def true_evaluation(cell: CellConfig, true_centres_part_m: dict[str, np.ndarray],
+                    true_diameters_m: dict[str, float]) -> Evaluation:  # fmt: skip
+    """The evaluation of the true part: its true characteristics and its true placement (the
+    true DRF's, which differs from the simulator's ``part_placement_error`` by what the datum
+    features' own machining scatter does to the DRF)."""
+    results = true_results(cell, true_centres_part_m, true_diameters_m)
+    return evaluate(cell, results, McOptions(n_draws=2))
+
+
+def coverage(reported: list[dict[str, Any]], truth: Evaluation) -> Coverage:
+    """Compare report.json's ``characteristics`` with the true part's (``truth``)."""
     true_by_id = {c["id"]: c for c in truth.characteristics}
     out = Coverage()
     for c in reported:
@@ -72,3 +78,16 @@ def coverage(cell: CellConfig, reported: list[dict[str, Any]],
             continue
         out.rows[c["id"]] = (float(c["value_m"]), float(c["U_m"]), float(t["value_m"]))
     return out
+
+
+def placement_error(reported: dict[str, Any], truth: Evaluation) -> dict[str, Any]:
+    """The reported placement minus the true one: translation (m) and rotation vector (rad)
+    per axis, and whether each lies within the reported U."""
+    true_T = truth.placement["T_fixture_part"]
+    T = reported["T_fixture_part"]
+    dt = np.subtract(T["xyz"], true_T["xyz"])
+    R = Rotation.from_quat(T["quat_xyzw"]) * Rotation.from_quat(true_T["quat_xyzw"]).inv()
+    dr = R.as_rotvec()
+    within = bool(np.all(np.abs(dt) <= reported["U_xyz_m"])
+                  and np.all(np.abs(dr) <= reported["U_rotation_rad"]))  # fmt: skip
+    return {"xyz_m": dt.tolist(), "rotation_rad": dr.tolist(), "within_U": within}
