@@ -48,6 +48,8 @@ class Evaluation:
     alignment: str
     frames: dict[str, tuple[Frames, Frames]] = field(default_factory=dict, repr=False)
     reason: str = ""
+    #: holes without a position characteristic, in the alignment (:meth:`_Run.hole_deviations`)
+    hole_deviations: dict[str, Any] = field(default_factory=dict)
 
     def fields(self) -> dict[str, Any]:
         """The mapping added to report.json."""
@@ -239,32 +241,66 @@ class _Run:
                                                      if d["id"] == drf_id)  # fmt: skip
         if why:
             return {**rec, **_blank("position"), "reason": why}
-        if drf_id == FIXTURE:
-            eye = Frames(np.eye(3)[None], np.zeros((1, 3)), {})
-            act, nom = Frames(np.repeat(eye.R, len(self.draws[h.id]), 0),
-                              np.zeros((len(self.draws[h.id]), 3)), {}), eye  # fmt: skip
-        else:
-            act, nom = self.frames[drf_id]
-        n_act = len(act.t)
-        nominal = nom.to_drf(self.nominal[h.id][None])[0]
-        axis = nom.R[0].T @ self.normals[h.id]
-        P = np.eye(3) - np.outer(axis, axis)
-        actual = act.to_drf(self.draws[h.id][:n_act])
-        dev = actual - nominal
-        values = 2.0 * np.linalg.norm(dev @ P, axis=1)
-        U = expanded(values[1:], values[0], self.opts.coverage)
+        d = self.deviation(h.id, drf_id)
+        values, U = d["values"], d["U_m"]
         bonus, limit, U_dec = 0.0, pos["zone_diameter_m"], U
         if pos["material_condition"] != "RFS" and size is not None:
             bonus = _bonus(h, r, pos["material_condition"], size)
             limit += bonus
             if bonus > 0.0:
                 U_dec = float(np.hypot(U, r.U_diameter_m or 0.0))
-        return {**rec, "bonus_m": bonus, "nominal_m": [float(v) for v in nominal],
-                "actual_m": [float(v) for v in actual[0]],
-                "deviation_m": [float(v) for v in dev[0]], "value_m": float(values[0]),
-                "axial_deviation_m": float(dev[0] @ axis),
+        return {**rec, "bonus_m": bonus, **d["fields"], "value_m": float(values[0]),
                 "U_m": U, "decision": decide_upper(float(values[0]), U_dec, limit, self.rule),
                 "reason": ""}  # fmt: skip
+
+    def deviation(self, hole_id: str, drf_id: str) -> dict[str, Any]:
+        """A measured hole in a frame: the draws of its position value 2|P d| (m), its U and
+        the fields nominal, actual, deviation, axial deviation and nominal axis (DRF, m)."""
+        if drf_id == FIXTURE:
+            n = len(self.draws[hole_id])
+            act = Frames(np.repeat(np.eye(3)[None], n, 0), np.zeros((n, 3)), {})
+            nom = Frames(np.eye(3)[None], np.zeros((1, 3)), {})
+        else:
+            act, nom = self.frames[drf_id]
+        nominal = nom.to_drf(self.nominal[hole_id][None])[0]
+        axis = nom.R[0].T @ self.normals[hole_id]
+        actual = act.to_drf(self.draws[hole_id][: len(act.t)])
+        dev = actual - nominal
+        values = 2.0 * np.linalg.norm(dev @ (np.eye(3) - np.outer(axis, axis)), axis=1)
+        fields = {"nominal_m": [float(v) for v in nominal],
+                  "actual_m": [float(v) for v in actual[0]],
+                  "deviation_m": [float(v) for v in dev[0]],
+                  "axial_deviation_m": float(dev[0] @ axis),
+                  "axis_drf": [float(v) for v in axis]}  # fmt: skip
+        return {
+            "values": values,
+            "U_m": expanded(values[1:], values[0], self.opts.coverage),
+            "fields": fields,
+        }
+
+    def hole_deviations(self, align: str, chars: list[dict[str, Any]]) -> dict[str, Any]:
+        """The holes without a position characteristic, in the run's alignment: in-plane
+        deviation (m), its U and the axial deviation, or the reason there is none."""
+        with_position = {c["hole_id"] for c in chars if c["kind"] == "position"}
+        out: dict[str, Any] = {}
+        for h in self.cell.part.holes:
+            if h.id in with_position or h.id not in self.results:
+                continue
+            why = _not_measured(self.cell, self.results, [h.id])
+            if not why and align != FIXTURE and align not in self.frames:
+                why = f"alignment {align} not evaluated"
+            if why:
+                out[h.id] = {"frame": align, "reason": why}
+                continue
+            d = self.deviation(h.id, align)
+            out[h.id] = {
+                "frame": align,
+                "position_deviation_m": float(d["values"][0] / 2),
+                "U_position_m": d["U_m"] / 2,
+                "axial_deviation_m": d["fields"]["axial_deviation_m"],
+                "reason": "",
+            }
+        return out
 
     def _size(self, h: Hole, size: dict) -> dict[str, Any]:
         rec = {
@@ -321,4 +357,6 @@ def evaluate(cell: CellConfig, results: list[HoleResult],
     datums = run.datum_records()
     align = run.alignment()
     chars = run.characteristics(align)
-    return Evaluation(run.drfs, datums, run.placement(align), chars, align, run.frames)
+    ev = Evaluation(run.drfs, datums, run.placement(align), chars, align, run.frames)
+    ev.hole_deviations = run.hole_deviations(align, chars)
+    return ev

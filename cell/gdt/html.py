@@ -127,12 +127,12 @@ def _char_table(fields: dict[str, Any]) -> str:
 
 
 def _deviation_plot(fields: dict[str, Any]) -> str:
-    """In-plane deviation vectors of the position characteristics at their nominals, in the
-    datum frame, seen along its z (the primary datum's normal); arrows 1 px per um, each
-    hole's zone (plus bonus) drawn as a circle about its nominal at the same scale."""
+    """In-plane deviations (perpendicular to each hole's axis) of the position
+    characteristics at their nominals, in the datum frame seen along its z (the primary
+    datum's normal); arrows 0.5 px per um, coloured by decision."""
     m = [c for c in fields["characteristics"] if c["kind"] == "position" and c["nominal_m"]
          and c["deviation_m"] is not None]  # fmt: skip
-    W, H = 900, 460
+    W, H, per_um = 900, 520, 0.5
     if not m:
         return svg(W, 60, [text(10, 30, "no position evaluated")], "deviation in the datum frame")
     nom = np.array([c["nominal_m"] for c in m]) * 1e3
@@ -143,17 +143,16 @@ def _deviation_plot(fields: dict[str, Any]) -> str:
     for c, p in zip(m, nom, strict=True):
         x, y = ax.x(p[0]), ax.y(p[1])
         col = COLOR[c["decision"]]
-        d = np.asarray(c["deviation_m"]) * 1e6
-        r = (c["zone_diameter_m"] + c["bonus_m"]) / 2 * 1e6
-        body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{r:.1f}" fill="none" stroke="{col}" '
-                    'stroke-width="0.6" stroke-dasharray="2,2"/>')  # fmt: skip
+        d = np.asarray(c["deviation_m"])
+        a = np.asarray(c.get("axis_drf") or [0.0, 0.0, 1.0])
+        d = (d - (d @ a) * a) * 1e6
         body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="2.5" fill="{col}"/>')
-        body.append(line(x, y, x + d[0], y - d[1], col, 1.6))
+        body.append(line(x, y, x + per_um * d[0], y - per_um * d[1], col, 1.6))
         body.append(text(x + 4, y - 4, c["hole_id"], 8, fill="#555"))
-    body.append(line(W - 180, 30, W - 130, 30, "#000", 1.6))
-    body.append(text(W - 125, 34, "50 um of deviation", 10))
-    body.append(text(ax.left + 6, ax.top + 14, "deviation of each centre in the datum frame "
-                     "(dashed: the zone's radius, same scale)", 10, fill="#555"))  # fmt: skip
+    body.append(line(W - 190, 30, W - 140, 30, "#000", 1.6))
+    body.append(text(W - 135, 34, "100 um of deviation", 10))
+    body.append(text(ax.left + 6, ax.top + 14, "in-plane deviation of each centre in the datum "
+                     "frame, seen along the primary datum's normal", 10, fill="#555"))  # fmt: skip
     return svg(W, H, body, "deviation vectors in the datum reference frame")
 
 

@@ -50,10 +50,18 @@ def apply_to_rows(ev: Evaluation, rows: list[dict[str, Any]]) -> None:
     for c in ev.characteristics:
         by_hole.setdefault(c["hole_id"], []).append(c)
     for row in rows:
-        chars = by_hole.get(row["hole_id"])
-        if not chars or (ev.alignment == FIXTURE and all(c["legacy"] for c in chars)):
+        chars = by_hole.get(row["hole_id"], [])
+        if ev.alignment == FIXTURE and all(c["legacy"] for c in chars):
             continue
-        _apply_one(row, chars)
+        other = ev.hole_deviations.get(row["hole_id"])
+        if other is not None and row["position_deviation_m"] is not None:
+            row["position_deviation_m"] = other.get("position_deviation_m")
+            row["U_position_m"] = other.get("U_position_m")
+            row["axial_deviation_m"] = other.get("axial_deviation_m")
+            if other["reason"]:
+                row["reason"] = "; ".join(filter(None, [row["reason"], other["reason"]]))
+        if chars:
+            _apply_one(row, chars)
 
 
 def _apply_one(row: dict[str, Any], chars: list[dict[str, Any]]) -> None:
