@@ -13,8 +13,10 @@ SIGMA_M = 8e-6
 
 
 def placement(mm: float = 1.5, deg: float = 0.4) -> np.ndarray:
+    """The part off its fixture by ``mm`` and ``deg`` in a fixed oblique direction (4x4)."""
     T = np.eye(4)
-    T[:3, :3] = Rotation.from_rotvec(np.radians(deg) * np.array([0.3, 0.5, 0.81]) / 1.0).as_matrix()
+    axis = np.array([0.3, 0.5, 0.81]) / np.linalg.norm([0.3, 0.5, 0.81])
+    T[:3, :3] = Rotation.from_rotvec(np.radians(deg) * axis).as_matrix()
     T[:3, 3] = mm * 1e-3 * np.array([0.8, -0.36, 0.48])
     return T
 
