@@ -98,6 +98,7 @@ class _Run:
         self.draws = draw_centres(results, opts.n_draws + 1, opts.seed)
         self.datum = {d.label: d for d in cell.part.datums}
         self.frames: dict[str, tuple[Frames, Frames]] = {}  # id -> (actual draws, nominal)
+        self.nominal_frames: dict[str, Frames] = {}  # id -> nominal DRF (whatever was measured)
         self.drfs: list[dict[str, Any]] = []
         self.by_labels: dict[tuple[str, ...], str] = {}
 
@@ -117,6 +118,8 @@ class _Run:
         self.by_labels[labels] = drf_id
         datums = [self.datum[lab] for lab in labels]
         rec: dict[str, Any] = {"id": drf_id, "datums": list(labels)}
+        nominal = {k: v[None] for k, v in self.nominal.items()}
+        self.nominal_frames[drf_id] = datum_frame(datums, nominal, self.nominal, self.normals)
         why = "; ".join(f"datum {d.label}: {w}" for d in datums
                         if (w := _not_measured(self.cell, self.results, d.hole_ids())))  # fmt: skip
         if not why:
@@ -128,9 +131,8 @@ class _Run:
         return drf_id
 
     def _frames(self, datums: list[Datum]) -> tuple[Frames, Frames]:
-        nominal = {k: v[None] for k, v in self.nominal.items()}
         actual = datum_frame(datums, self.draws, self.nominal, self.normals)
-        return actual, datum_frame(datums, nominal, self.nominal, self.normals)
+        return actual, self.nominal_frames[self.by_labels[tuple(d.label for d in datums)]]
 
     def _drf_fields(self, drf_id: str, why: str) -> dict[str, Any]:
         if drf_id not in self.frames:
@@ -240,7 +242,10 @@ class _Run:
             why = f"{drf_id} not evaluated: " + next(d["reason"] for d in self.drfs
                                                      if d["id"] == drf_id)  # fmt: skip
         if why:
-            return {**rec, **_blank("position"), "reason": why}
+            nom = self.nominal_frames.get(drf_id)
+            nominal = (list(h.position) if nom is None  # the fixture frame: the part's own
+                       else nom.to_drf(self.nominal[h.id][None])[0].tolist())  # fmt: skip
+            return {**rec, **_blank("position"), "nominal_m": nominal, "reason": why}
         d = self.deviation(h.id, drf_id)
         values, U = d["values"], d["U_m"]
         bonus, limit, U_dec = 0.0, pos["zone_diameter_m"], U

@@ -89,6 +89,9 @@ def test_report_of_a_run_whose_datum_was_not_measured(tmp_path: Path) -> None:
                 and a["data-decision"] == "not_evaluated"]  # fmt: skip
     assert len(not_eval) == 40  # 39 positions and the missing hole's size
     assert doc["placement"]["status"] == "not_evaluated"
+    not_pos = [c for c in doc["characteristics"] if c["decision"] == "not_evaluated"
+               and c["kind"] == "position"]  # fmt: skip
+    assert all(len(c["nominal_m"]) == 3 and c["value_m"] is None for c in not_pos)
     row = next(h for h in doc["holes"] if h["hole_id"] == "SHL1")
     assert row["position_deviation_m"] is None and row["decision"] is None
     assert "datum C" in row["reason"] and "HT1" in row["reason"]
