@@ -169,6 +169,12 @@ def format_summary(summ: dict[str, Any]) -> str:
         f"{summ['holes_nonconforming']} nonconformance proven "
         f"(rule {summ['decision_rule'] or '-'})",
     ]
+    chars = summ.get("characteristics")
+    if chars:  # cell.gdt: the drawing's characteristics in the run's alignment
+        lines.append(f"characteristics {chars['conformance']} conformance proven, "
+                     f"{chars['inconclusive']} inconclusive, {chars['nonconformance']} "
+                     f"nonconformance proven, {chars['not_evaluated']} not evaluated "
+                     f"(alignment {summ['alignment']})")  # fmt: skip
     part = summ.get("part")
     if part:
         lines.append(f"part            {part['temperature_c']:.2f} degC "
