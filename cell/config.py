@@ -311,7 +311,7 @@ class CellConfig(_Strict):
             s.to_shape(np.eye(4), f"env{i}", d) for i, s in enumerate(self.environment.obstacles)
         ]
         t = self.calibration_target
-        return part + env + ([] if t is None else [t.plate_shape(t.T_cell_target())])
+        return part + ([] if t is None else [t.plate_shape(t.T_cell_target())]) + env
 
     def _relative_to_cell(self, path: str) -> Path:
         p = Path(path).expanduser()

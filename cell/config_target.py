@@ -28,13 +28,15 @@ from __future__ import annotations
 import csv
 import math
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from measure.target import TargetSpec
 from robots import Shape
+
+if TYPE_CHECKING:  # measure.target imports OpenCV: loaded when a board is needed, not with a cell
+    from measure.target import TargetSpec
 
 #: a measured feature farther than this fraction of the pitch from the nominal grid is a mistake
 CORNER_TOLERANCE_PITCH = 0.25
@@ -77,6 +79,8 @@ class CalibrationTargetBoard(BaseModel):
 
     def target_spec(self) -> TargetSpec:
         """The board as :mod:`measure.target` detects and renders it."""
+        from measure.target import TargetSpec
+
         return TargetSpec(self.pattern, self.cols, self.rows, self.pitch_m)
 
     def corners_path(self, base_dir: Path | None) -> Path | None:

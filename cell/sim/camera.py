@@ -97,7 +97,10 @@ class SimCamera:
     def _capture(self, t: float) -> StereoPair:
         T_cell_tcp = self.world.true_T_cell_tcp(self.controller.q_rad(), t)
         kind, feature = self._in_view(invert(T_cell_tcp @ self._T_head_left))
-        key = feature.id if feature is not None else "none"
+        s_target = self._target_distance(T_cell_tcp)
+        if s_target is not None and (feature is None or s_target < _depth(T_cell_tcp, feature)):
+            kind, feature = "target", None  # the plate is in front of whatever lies behind it
+        key = "calibration_target" if kind == "target" else feature.id if feature else "none"
         seed = (self._seed * 1_000_003 + zlib.crc32(key.encode())) & 0x7FFFFFFF
         if self._rep_sigma_m > 0:  # the arm's repeatability: this approach's scatter
             rng = np.random.default_rng([self.world.truth.seed, seed, self.captures])
@@ -106,7 +109,7 @@ class SimCamera:
         T_cell_left = T_cell_tcp @ self._T_head_left
         T_left_cell = invert(T_cell_left)
         self.captures += 1
-        if feature is None and self._sees_target(T_cell_tcp):
+        if kind == "target":
             return self._target_pair(T_cell_left, seed)
         if feature is None:  # bare surface facing the head, no hole anywhere near the view
             pair = render_hole_pair(self.true_stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
@@ -124,21 +127,21 @@ class SimCamera:
         )
         return StereoPair(pair.left, pair.right)
 
-    def _sees_target(self, T_cell_tcp: np.ndarray) -> bool:
-        """The head's view axis meets the calibration plate's printed face from in front,
-        within ``TARGET_RANGE_M`` (the plate's true pose)."""
+    def _target_distance(self, T_cell_tcp: np.ndarray) -> float | None:
+        """How far along the head's view axis it meets the calibration plate's printed face
+        from in front (m; the plate's true pose), or None: not within ``TARGET_RANGE_M``."""
         T_cell_target = self.world.T_cell_target
         if T_cell_target is None:
-            return False
+            return None
         T = invert(T_cell_target) @ T_cell_tcp  # the head in the board frame
         o, d = T[:3, 3], T[:3, 2]
         if not (o[2] < 0 < d[2]):  # the face is z = 0 and faces -z
-            return False
-        s = -o[2] / d[2]
+            return None
+        s = float(-o[2] / d[2])
         lo, hi = self.world.cell.calibration_target.target_spec().plate_bounds()
         p = o + s * d
         inside = lo[0] <= p[0] <= hi[0] and lo[1] <= p[1] <= hi[1]
-        return bool(inside and TARGET_RANGE_M[0] <= s <= TARGET_RANGE_M[1])
+        return s if inside and TARGET_RANGE_M[0] <= s <= TARGET_RANGE_M[1] else None
 
     def _target_pair(self, T_cell_left: np.ndarray, seed: int) -> StereoPair:
         """Render the calibration plate at its true pose in the true head."""
@@ -166,3 +169,8 @@ class SimCamera:
 
     def close(self) -> None:
         """Nothing to release."""
+
+
+def _depth(T_cell_head: np.ndarray, feature: TrueHole) -> float:
+    """Distance of ``feature`` along the head's view axis (m)."""
+    return float((invert(T_cell_head) @ np.append(feature.position_m, 1.0))[2])

@@ -47,6 +47,7 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from cell.config import CellConfig
+from cell.errors import TruthFileError
 from cell.sim.truth_file import FORMAT, TruthSpec, read_truth_spec
 from cell.uncertainty.repeatability import repeatability_rp_m
 from robots import DEFAULT_MODEL
@@ -76,7 +77,7 @@ _STREAM = {
 }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CellTruth:
     """Every hidden error of one simulated cell (m, rad, degC); see the module docstring.
 
@@ -99,6 +100,17 @@ class CellTruth:
     repeatability_rp_m: float
     calibration_sigma_scale: float
     part_temperature_c: float
+
+    def __post_init__(self) -> None:
+        """Shapes and finiteness checked; the arrays are copied read-only."""
+        shapes = {"dh_errors": (6, 4), "base_error": (4, 4), "tcp_error": (4, 4),
+                  "part_placement_error": (4, 4), "target_placement_error": (4, 4)}  # fmt: skip
+        for name, shape in shapes.items():
+            a = np.array(getattr(self, name), dtype=float)
+            if a.shape != shape or not np.all(np.isfinite(a)):
+                raise TruthFileError("CellTruth", [(name, a.shape, f"need finite {shape}")])
+            a.setflags(write=False)
+            object.__setattr__(self, name, a)
 
     @staticmethod
     def zero(seed: int = 0) -> CellTruth:
