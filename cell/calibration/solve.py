@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from cell.calibration.errors import DegenerateCalibrationError
+from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationError
 from cell.calibration.identifiability import IdentifiabilityReport, choose_free
 from cell.calibration.initial import InitialEstimate, initial_estimate
 from cell.calibration.model import State, column_names, flange_poses, predict, step_state
@@ -61,6 +61,9 @@ class SolveOptions:
             spread; the largest must reach it.
         min_axis_spread_rad: smallest spread of the relative rotation axes.
         max_nfev: limit of residual evaluations of the solver.
+        max_dh_length_m, max_dh_angle_rad: largest plausible D-H length and angle error; a
+            fit beyond says the joints belong to another arm (or another joint zero) than the
+            nominal table, and is refused.
     """
 
     estimate_kinematics: bool = True
@@ -71,6 +74,8 @@ class SolveOptions:
     min_rotation_rad: float = math.radians(5.0)
     min_axis_spread_rad: float = math.radians(5.0)
     max_nfev: int = 200
+    max_dh_length_m: float = 0.01
+    max_dh_angle_rad: float = math.radians(2.0)
 
     def __post_init__(self) -> None:
         if not self.max_condition > 1.0:
@@ -198,6 +203,7 @@ def solve_calibration(
     )
     t_rank = time.perf_counter()
     state = _fit(obs, dh, start, report.free, opts)
+    _check_plausible(obs, state, report.free, opts)
     pred = predict(obs, dh, state)  # at the solution: the perturbation there is exact
     Jf = pred.jacobian[:, [columns.index(c) for c in report.free]]
     n, p = len(pred.residuals), len(report.free)
@@ -220,6 +226,26 @@ def solve_calibration(
             "total_s": t_end - t0,
         },
     )
+
+
+def _check_plausible(
+    obs: CalibrationObservations, state: State, free: tuple[str, ...], opts: SolveOptions
+) -> None:
+    """Refuse D-H errors no arm of the nominal model has (another arm's joints, say)."""
+    for k, name in enumerate(term_names()):
+        if f"dh.{name}" not in free:
+            continue
+        value = float(state.delta[k])
+        length = name.endswith("_m")
+        limit = opts.max_dh_length_m if length else opts.max_dh_angle_rad
+        if abs(value) > limit:
+            shown = f"{value * 1e3:.2f} mm" if length else f"{math.degrees(value):.3f} deg"
+            bound = f"{limit * 1e3:g} mm" if length else f"{math.degrees(limit):g} deg"
+            raise CalibrationDataError(
+                obs.source,
+                f"the fit needs a D-H error {name} = {shown} (plausible: within {bound}): "
+                "do the joints come from the arm of the nominal table (the cell's robot model)?",
+            )
 
 
 def _fit(
