@@ -6,10 +6,12 @@ Observations -> refusals (:mod:`cell.calibration.refusals`) -> starting values f
 :mod:`cell.calibration.model`, columns scaled by their norms, plain squared loss so the
 covariance means what it says) -> :class:`~cell.calibration.result.CellCalibration`.
 
-Covariance of every free unknown: ``s^2 (J^T J)^-1`` with ``J`` the Jacobian at the solution
-and ``s^2 = sum(r^2) / (n - p)`` from the residuals (n corner coordinates, p free unknowns):
-the corner noise is estimated from the data, taken equal in both cameras and independent
-between corners. The intrinsics are taken as exact (from the stereo calibration file); the
+Covariance of every free unknown (:mod:`cell.calibration.covariance`): the corner noise
+``s^2`` from the residuals, taken equal in both cameras and independent between corners, plus
+(by default) an independent error of each view's flange pose (the arm's repeatability and
+what the kinematic model leaves out), estimated from the per-view residuals or given: the
+sandwich ``(J^T J)^-1 J^T Omega J (J^T J)^-1`` at the solution. With ``flange_scatter=False``,
+``s^2 (J^T J)^-1``. The intrinsics are taken as exact (from the stereo calibration file); the
 target's geometry as exact (it fixes the scale).
 """
 
@@ -17,7 +19,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -292,4 +294,4 @@ def pose_error(T_est: Array, T_true: Array) -> tuple[float, float]:
     return dp, da
 
 
-__all__ = ["CalibrationResult", "SolveOptions", "pose_error", "replace", "solve_calibration"]
+__all__ = ["CalibrationResult", "SolveOptions", "pose_error", "solve_calibration"]
