@@ -122,3 +122,42 @@ def flange_scatter_covariance(
         meat += G.T @ Sigma @ G
     cov = B @ meat @ B
     return CovarianceResult(0.5 * (cov + cov.T), s2, st, sr, source)
+
+
+class ViewWhitening:
+    """``Omega^(-1/2)`` of the residuals: per view ``(I - Q Q^T) / s + Q C Q^T`` with
+    ``A_v = Q R`` (thin QR) and ``C = (s^2 I + R Sigma R^T)^(-1/2)``; applied to residuals (n,)
+    or Jacobians (n, p), it makes the generalised least squares an ordinary one (weights fixed
+    at the linearisation point)."""
+
+    def __init__(
+        self, F: Array, rows_view: NDArray[np.int64], s2: float, sigma_m: float, sigma_rad: float
+    ) -> None:
+        self.s = float(np.sqrt(s2))
+        Sigma = np.diag([sigma_m**2] * 3 + [sigma_rad**2] * 3)
+        self.blocks = []
+        for v in np.unique(rows_view):
+            sel = np.flatnonzero(rows_view == v)
+            Q, R = np.linalg.qr(F[sel])
+            w, U = np.linalg.eigh(s2 * np.eye(6) + R @ Sigma @ R.T)
+            self.blocks.append((sel, Q, (U / np.sqrt(w)) @ U.T))
+
+    def __call__(self, x: Array) -> Array:
+        out = np.empty_like(x)
+        for sel, Q, C in self.blocks:
+            xs = x[sel]
+            qx = Q.T @ xs
+            out[sel] = (xs - Q @ qx) / self.s + Q @ (C @ qx)
+        return out
+
+
+def gls_covariance(Jw: Array, result: CovarianceResult) -> CovarianceResult:
+    """The covariance of the generalised least-squares estimate, ``(J_w^T J_w)^-1`` with ``J_w``
+    the whitened Jacobian at its solution (same noise and scatter as ``result``)."""
+    return CovarianceResult(
+        _inverse_normal(Jw),
+        result.s2_px,
+        result.flange_sigma_m,
+        result.flange_sigma_rad,
+        result.source,
+    )

@@ -27,7 +27,12 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from cell.calibration.assemble import build_calibration
-from cell.calibration.covariance import flange_scatter_covariance, white_covariance
+from cell.calibration.covariance import (
+    ViewWhitening,
+    flange_scatter_covariance,
+    gls_covariance,
+    white_covariance,
+)
 from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationError
 from cell.calibration.identifiability import IdentifiabilityReport, choose_free
 from cell.calibration.initial import InitialEstimate, initial_estimate
@@ -218,15 +223,26 @@ def solve_calibration(
         raise DegenerateCalibrationError(f"{n} corner coordinates for {p} unknowns")
     if opts.flange_scatter:
         n_stereo = sum(c.startswith("T_left_right.") for c in report.free)
+        rows_view = np.repeat(pred.view_index, 2)
         cr = flange_scatter_covariance(
             Jf,
             pred.residuals,
             pred.flange_jacobian,
-            np.repeat(pred.view_index, 2),
+            rows_view,
             n_stereo,
             opts.flange_sigma_m,
             opts.flange_sigma_rad,
         )
+        if cr.flange_sigma_m > 0 or cr.flange_sigma_rad > 0:
+            # the views' corners move together: weight by Omega^-1 (generalised least squares)
+            weight = ViewWhitening(
+                pred.flange_jacobian, rows_view, cr.s2_px, cr.flange_sigma_m, cr.flange_sigma_rad
+            )
+            state = _fit(obs, dh, state, report.free, opts, weight)
+            _check_plausible(obs, state, report.free, opts)
+            pred = predict(obs, dh, state)
+            Jf = pred.jacobian[:, [columns.index(c) for c in report.free]]
+            cr = gls_covariance(weight(Jf), cr)
     else:
         cr = white_covariance(Jf, pred.residuals)
     t_end = time.perf_counter()
@@ -271,12 +287,18 @@ def _fit(
     start: State,
     free: tuple[str, ...],
     opts: SolveOptions,
+    weight: ViewWhitening | None = None,
 ) -> State:
+    """Least squares over the free unknowns from ``start``; ``weight`` whitens the residuals
+    (generalised least squares with the views' flange scatter)."""
     prob = _Problem(obs, dh, start, free)
+    fun, jac = prob.residuals, prob.jacobian
+    if weight is not None:
+        fun, jac = (lambda x: weight(prob.residuals(x))), (lambda x: weight(prob.jacobian(x)))
     sol = least_squares(
-        prob.residuals,
+        fun,
         np.zeros(len(free)),
-        jac=prob.jacobian,
+        jac=jac,
         method="lm",
         x_scale="jac",
         xtol=1e-12,
