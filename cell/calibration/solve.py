@@ -9,8 +9,9 @@ covariance means what it says) -> :class:`~cell.calibration.result.CellCalibrati
 Covariance of every free unknown (:mod:`cell.calibration.covariance`): the corner noise
 ``s^2`` from the residuals, taken equal in both cameras and independent between corners, plus
 (by default) an independent error of each view's flange pose (the arm's repeatability and
-what the kinematic model leaves out), estimated from the per-view residuals or given: the
-sandwich ``(J^T J)^-1 J^T Omega J (J^T J)^-1`` at the solution. With ``flange_scatter=False``,
+what the kinematic model leaves out), estimated from the per-view residuals or given; with a
+scatter, the fit is repeated by generalised least squares (each view's residuals whitened by
+``Omega_v^-1/2``) and ``(J^T Omega^-1 J)^-1`` is stated. With ``flange_scatter=False``,
 ``s^2 (J^T J)^-1``. The intrinsics are taken as exact (from the stereo calibration file); the
 target's geometry as exact (it fixes the scale).
 """
