@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -201,6 +201,8 @@ def solve_calibration(
         init = initial_estimate(obs, T_bt)
         L = obs.cameras.T_left_right if obs.cameras.stereo else None
         start = State(init.best.T_tool0_camera, init.best.T_base_target, L, np.zeros(24))
+    if start.T_left_right is not None and not obs.corners("right")[1].any():
+        start = replace(start, T_left_right=None)  # no right image saw the plate: mono
     t_init = time.perf_counter()
     stereo = start.T_left_right is not None
     kinematic = dh is not None and obs.has_joints
