@@ -2,12 +2,13 @@
 
 1. Candidate views of the cell's calibration target (:func:`planner.calibration.candidate_views`):
    both cameras see the whole board at a good distance and tilt, IK within limits, no collision.
-2. A geometric pre-selection (:func:`planner.calibration.preselect`) of ``pool`` views: large
+2. A geometric pre-selection (:func:`planner.calibration.preselect`) of ``views`` views: large
    rotations about axes far from parallel, features over both whole images, joints over the
    range the hole tour uses (``joint_range``: its stops, widened by ``JOINT_RANGE_MARGIN_RAD``).
-3. The design (``criterion``): ``"geometric"`` keeps the pre-selection's first ``views``;
-   ``"tcp"`` and ``"d"`` choose ``views`` of the pool by the calibration adjustment's
-   information (:mod:`cell.calibration_plan.design`).
+3. The design (``criterion``): ``"geometric"`` keeps the pre-selection; ``"tcp"`` and ``"d"``
+   choose ``views`` of all candidates by the calibration adjustment's information
+   (:mod:`cell.calibration_plan.design`: greedy and exchange, and exchange from the
+   pre-selection; the better design wins), and every criterion predicts the parameters' σ.
 4. The tour through them (:func:`planner.calibration.plan_view_tour`): the hole tour's GTSP,
    OMPL and ruckig machinery, so collision-free and jerk-limited.
 """
@@ -20,10 +21,17 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from cell.calibration_plan.design import (
+    CORNER_SIGMA_PX,
+    design_rows,
+    information_model,
+    predict_sigmas,
+)
 from cell.calibration_plan.head_model import stereo_model
 from cell.calibration_plan.target import TargetGeometry, board_of
 from cell.config import CellConfig
 from cell.errors import CellError
+from cell.uncertainty.repeatability import repeatability_rp_m, sigma_per_axis_m
 from measure import StereoCalibration
 from planner import Options
 from planner.calibration import (
@@ -50,15 +58,20 @@ JOINT_RANGE_MARGIN_RAD = np.radians(10.0)
 class CalibrationPlanOptions:
     """Settings of :func:`plan_calibration`.
 
-    ``views``: stations in the tour; ``pool``: views kept by the geometric pre-selection for the
-    information-based design; ``criterion``: one of :data:`CRITERIA`; ``candidates`` /
-    ``preselect``: the planner's sampling and pre-selection settings; ``tour``: the tour
-    planner's :class:`planner.Options` (dwell, seed, resolution, ...).
+    ``views``: stations in the tour; ``criterion``: one of :data:`CRITERIA`; ``predict``:
+    compute the predicted σ (needs the arm's D-H table; always on for "tcp" and "d");
+    ``corner_sigma_px``: the corner noise per image axis of the design and the prediction (px);
+    ``repeatability``: the arm's repeatability (the cell's RP) scatters each view's head pose in
+    the design and the prediction; ``candidates`` / ``preselect``: the planner's sampling and
+    pre-selection settings; ``tour``: the tour planner's :class:`planner.Options` (dwell, seed,
+    resolution, ...).
     """
 
     views: int = 20
-    pool: int = 150
     criterion: str = "tcp"
+    predict: bool = True
+    corner_sigma_px: float = CORNER_SIGMA_PX
+    repeatability: bool = True
     candidates: CandidateOptions = field(default_factory=CandidateOptions)
     preselect: PreselectOptions = field(default_factory=PreselectOptions)
     tour: Options = field(default_factory=Options)
@@ -68,8 +81,8 @@ class CalibrationPlanOptions:
             raise CellError(f"criterion {self.criterion!r}: expected one of {', '.join(CRITERIA)}")
         if self.views < 1:
             raise CellError(f"views {self.views}: at least one calibration view is needed")
-        if self.pool < self.views:
-            raise CellError(f"pool {self.pool}: must hold at least the {self.views} views")
+        if not (self.corner_sigma_px > 0 and np.isfinite(self.corner_sigma_px)):
+            raise CellError(f"corner_sigma_px {self.corner_sigma_px}: must be a positive number")
 
 
 def joint_range(stops_q: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -104,18 +117,21 @@ def plan_calibration(
         )
     box = joint_range(stops_q)
     t = time.perf_counter()
-    pool = preselect(cands, min(o.pool, len(cands)), head.image_size, box, o.preselect)
+    geometric = preselect(cands, o.views, head.image_size, box, o.preselect)
     timings["preselect"] = time.perf_counter() - t
     t = time.perf_counter()
-    prediction: dict = {}
-    if o.criterion == "geometric":
-        rows = pool[: o.views]
+    if o.criterion == "geometric" and not o.predict:
+        rows, prediction = geometric, {}
     else:
-        from cell.calibration_plan.design import information_design
-
-        rows, prediction = information_design(
-            cell, target, stereo, cands, pool, o.views, o.criterion, stops_q
+        rp_m, _ = repeatability_rp_m(cell.robot.model, cell.robot.repeatability_m)
+        rep = sigma_per_axis_m(rp_m) if o.repeatability else 0.0
+        model = information_model(cell, target, stereo, cands, stops_q, o.corner_sigma_px, rep)
+        rows = (
+            geometric
+            if o.criterion == "geometric"
+            else design_rows(model, o.views, o.criterion, [geometric])
         )
+        prediction = predict_sigmas(model, rows)
     timings["design"] = time.perf_counter() - t
     chosen = cands.subset(rows)
     ids = view_ids(len(rows))
@@ -125,7 +141,6 @@ def plan_calibration(
         "criterion": o.criterion,
         "candidates": len(cands),
         "refused": cands.refused,
-        "pool": len(pool),
         "rotation_share": score.rotation,
         "image_share": score.image,
         "joint_share": score.joints,

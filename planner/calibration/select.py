@@ -209,6 +209,32 @@ def _criterion(M: NDArray[np.float64], W: NDArray[np.float64] | None) -> NDArray
     return out
 
 
+def information_factors(blocks: NDArray[np.float64], rel_tol: float = 1e-10) -> NDArray[np.float64]:
+    """``U`` (m, p, r) with ``U_j U_j^T = blocks[j]`` (positive semi-definite (m, p, p)); ``r``
+    the largest rank among the blocks (eigenvalues below ``rel_tol`` of the largest dropped).
+    A view of a board fixes the board's pose in each camera, so ``r`` is small (≤ 12)."""
+    w, V = np.linalg.eigh(blocks)
+    w = np.clip(w, 0.0, None)
+    keep = w > rel_tol * w.max(axis=1, keepdims=True)
+    r = max(int(keep.sum(axis=1).max()), 1)
+    return V[:, :, -r:] * np.sqrt(w[:, None, -r:])
+
+
+def _with_each(
+    M: NDArray[np.float64], U: NDArray[np.float64], W: NDArray[np.float64] | None
+) -> NDArray[np.float64]:
+    """The criterion (:func:`_criterion`) of ``M + U_j U_j^T`` for every j, by the matrix
+    determinant lemma and Woodbury's identity (``M`` positive definite): r × r work per view."""
+    Minv = np.linalg.inv(M)
+    MU = Minv @ U  # (m, p, r)
+    A = np.eye(U.shape[2]) + np.swapaxes(U, 1, 2) @ MU
+    if W is None:
+        _, logdet = np.linalg.slogdet(M)
+        return -(logdet + np.linalg.slogdet(A)[1])
+    C = np.swapaxes(MU, 1, 2) @ (W @ MU)
+    return float(np.trace(W @ Minv)) - np.einsum("mrr->m", np.linalg.solve(A, C))
+
+
 def design_value(
     blocks: NDArray[np.float64],
     rows: list[int],
@@ -225,19 +251,29 @@ def choose_by_information(
     n: int,
     prior: NDArray[np.float64],
     W: NDArray[np.float64] | None = None,
-    exchange_passes: int = 3,
+    exchange_passes: int = 10,
+    start: list[int] | None = None,
 ) -> list[int]:
     """Greedy then exchange choice of ``n`` of the views whose information blocks are
     ``blocks`` (m, p, p) (module docstring). ``prior`` (p, p): the information before any view
-    (e.g. the parameters' prior σ^-2 on the diagonal), which keeps the early steps regular.
-    Returns rows of ``blocks``, in the order chosen."""
+    (e.g. the parameters' prior σ^-2 on the diagonal, positive definite), which keeps the early
+    steps regular.
+    ``start``: ``n`` distinct rows to exchange from instead of the greedy choice. Returns rows
+    of ``blocks`` (greedy: in the order chosen)."""
     m = len(blocks)
     if n < 1 or n > m:
         raise PlanningError(f"cannot choose {n} calibration views from {m} candidates")
-    chosen: list[int] = []
+    U = information_factors(blocks)
     M = np.asarray(prior, dtype=float).copy()
-    for _ in range(n):
-        value = _criterion(M[None] + blocks, W)
+    if start is not None:
+        chosen = [int(k) for k in start]
+        if len(set(chosen)) != n or min(chosen) < 0 or max(chosen) >= m:
+            raise PlanningError(f"a start design must hold {n} distinct rows of {m}")
+        M = M + blocks[chosen].sum(axis=0)
+    else:
+        chosen = []
+    while len(chosen) < n:
+        value = _with_each(M, U, W)
         value[chosen] = np.inf
         j = int(np.argmin(value))
         if not np.isfinite(value[j]):
@@ -248,10 +284,10 @@ def choose_by_information(
         improved = False
         for slot in range(n):
             base = M - blocks[chosen[slot]]
-            value = _criterion(base[None] + blocks, W)
+            value = _with_each(base, U, W)
+            current = value[chosen[slot]]
             value[[c for k, c in enumerate(chosen) if k != slot]] = np.inf
             j = int(np.argmin(value))
-            current = float(_criterion((base + blocks[chosen[slot]])[None], W)[0])
             if value[j] < current - 1e-9 * abs(current) - 1e-12:
                 chosen[slot] = j
                 M = base + blocks[j]

@@ -25,7 +25,7 @@ def cell():
 
 def test_geometric_plan_of_a_placed_target(cell, tmp_path) -> None:
     stops = np.array([cell.home_q(), cell.home_q() + 0.3])
-    o = CalibrationPlanOptions(views=5, pool=20, criterion="geometric", tour=Options(seed=1))
+    o = CalibrationPlanOptions(views=5, criterion="geometric", tour=Options(seed=1))
     cal = plan_calibration(cell, TARGET, cell_stereo(cell), stops, o)
     assert len(cal.tour.stops) == 5 and not cal.tour.left_out
     assert cal.design["min_rotation_rad"] > np.radians(20)
@@ -38,7 +38,7 @@ def test_geometric_plan_of_a_placed_target(cell, tmp_path) -> None:
 
 
 def test_more_views_than_feasible_are_refused(cell) -> None:
-    o = CalibrationPlanOptions(views=5000, pool=5000, criterion="geometric")
+    o = CalibrationPlanOptions(views=5000, criterion="geometric")
     with pytest.raises(CellError, match="feasible view"):
         plan_calibration(cell, TARGET, cell_stereo(cell), np.array([cell.home_q()]), o)
 
@@ -46,5 +46,5 @@ def test_more_views_than_feasible_are_refused(cell) -> None:
 def test_bad_options_are_refused() -> None:
     with pytest.raises(CellError, match="criterion"):
         CalibrationPlanOptions(criterion="e")
-    with pytest.raises(CellError, match="pool"):
-        CalibrationPlanOptions(views=10, pool=5)
+    with pytest.raises(CellError, match="corner_sigma_px"):
+        CalibrationPlanOptions(corner_sigma_px=0.0)
