@@ -34,6 +34,7 @@ from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
+from cell.sim.truth import CellTruth
 from cell.sim.world import WorldOptions
 from planner import Options, plan_tour
 from robots.thermal.drift import DriftSettings, WarmUp
@@ -95,7 +96,8 @@ def faulty_runs(cell, tour, root: Path, seeds: list[int]) -> None:
                            disconnect_s=2.0, seed=seed)  # fmt: skip
         link = LinkOptions(response_timeout_s=0.05, retries=8)
         t0 = time.perf_counter()
-        with SimCell.start(cell, WorldOptions(speed=20.0, drift=STEADY, seed=seed), faults) as sim:
+        world = WorldOptions(speed=20.0, drift=STEADY, truth=CellTruth.zero(seed))
+        with SimCell.start(cell, world, faults) as sim:
             result, stored = run_once(cell, tour, root / f"faulty{seed}", sim, link)
             srv = sim.server
         ids = [r.hole_id for r in stored]

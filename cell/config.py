@@ -20,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError,
 
 from cell.config_checks import cell_problems
 from cell.config_mesh import MeshSpec
+from cell.config_target import CalibrationTargetBoard
 from cell.errors import ConfigError
 from cell.holes_csv import read_holes_csv
 from cell.uncertainty.materials import (
@@ -210,6 +211,17 @@ class ReferenceTarget(_Strict):
     _unit_normal = field_validator("normal")(lambda cls, v: _unit(v))
 
 
+class CalibrationTarget(CalibrationTargetBoard):
+    """``calibration_target``: the plate board (:mod:`cell.config_target`) and its nominal
+    pose in the cell."""
+
+    pose: Pose
+
+    def T_cell_target(self) -> np.ndarray:
+        """Nominal pose of the board frame in the cell."""
+        return self.pose.matrix()
+
+
 @dataclass(frozen=True)
 class HoleInCell:
     """A hole in the cell frame: centre (m), unit normal out of the surface, diameter (m)."""
@@ -230,6 +242,7 @@ class CellConfig(_Strict):
     part: Part
     environment: Environment = Environment()
     reference_targets: list[ReferenceTarget] = []
+    calibration_target: CalibrationTarget | None = None
 
     _source_path: Path | None = PrivateAttr(default=None)
     _raw_text: str = PrivateAttr(default="")
@@ -285,13 +298,14 @@ class CellConfig(_Strict):
         return [s.to_shape(np.eye(4), f"tool{i}", d) for i, s in enumerate(self.tool.shapes)]
 
     def obstacle_shapes(self) -> list[Shape]:
-        """Part and environment obstacles, poses in the cell frame."""
+        """Part and environment obstacles and the calibration plate, poses in the cell frame."""
         T_part, d = self.T_cell_part(), self.base_dir
         part = [s.to_shape(T_part, f"part{i}", d) for i, s in enumerate(self.part.obstacles)]
         env = [
             s.to_shape(np.eye(4), f"env{i}", d) for i, s in enumerate(self.environment.obstacles)
         ]
-        return part + env
+        t = self.calibration_target
+        return part + ([] if t is None else [t.plate_shape(t.T_cell_target())]) + env
 
     def _relative_to_cell(self, path: str) -> Path:
         p = Path(path).expanduser()
