@@ -33,6 +33,7 @@ TCP and the view point at the hole tour's stops (RMS over the stops of ``sqrt(tr
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,7 +50,9 @@ from cell.calibration_plan.target import TargetGeometry
 from cell.config import CellConfig
 from cell.errors import CellError
 from measure import StereoCalibration
+from measure.target import TargetSpec
 from planner.calibration import Candidates, choose_by_information, design_value
+from planner.calibration.select import information_factors
 from robots.calibration import dh_error_twists, fk_with_errors, structural_redundancies
 from robots.dh import DHTable
 from robots.transforms import invert
@@ -63,23 +66,25 @@ PRIOR_SIGMA = {"pose_m": 0.01, "pose_rad": np.radians(3.0), "dh_m": 0.005, "dh_r
 CORNER_SIGMA_PX = 0.1
 
 
+#: candidates whose Jacobian is computed at once (bounds the memory: ~60 kB per view)
+CHUNK = 200
+
+
 @dataclass(frozen=True, eq=False)
 class InformationModel:
     """The candidates' information and the stops' sensitivities over ``columns``.
 
-    ``blocks`` (m, p, p): each candidate's information ``J_v^T Σ_v^-1 J_v``; ``jacobian_rows``
-    (m,) the row blocks ``J_v`` (px per unit); ``J_shift`` (m,) each view's corner motion per
-    rigid head displacement (px per m, the hand-eye translation columns); ``H_view`` /
-    ``H_tcp`` (S, 3, p): the view point's and the TCP's motion per unit of each unknown at the
-    stops; ``fixed``: the structurally redundant
-    terms left out, with the reason; ``residual_px``: the largest difference between the
-    adjustment's predicted corners and the candidates' (0 up to rounding: one lens model).
+    ``blocks`` (m, p, p): each candidate's information ``J_v^T Σ_v^-1 J_v``; ``jacobians(rows)``
+    the row blocks ``J_v`` (px per unit) of those candidates, recomputed by the adjustment's
+    model; ``H_view`` / ``H_tcp`` (S, 3, p): the view point's and the TCP's motion per unit of
+    each unknown at the stops; ``fixed``: the structurally redundant terms left out, with the
+    reason; ``residual_px``: the largest difference between the adjustment's predicted corners
+    and the candidates' (0 up to rounding: one lens model).
     """
 
     columns: tuple[str, ...]
     blocks: Array
-    jacobian_rows: list[Array]
-    J_shift: list[Array]
+    jacobians: Callable[[Sequence[int]], list[Array]]
     H_view: Array
     H_tcp: Array
     fixed: dict[str, str]
@@ -88,10 +93,14 @@ class InformationModel:
     repeatability_sigma_m: float
     residual_px: float
 
-    def view_covariance_term(self, k: int) -> Array:
-        """``J_v^T Σ_v J_v`` of candidate ``k`` (the middle of the OLS sandwich)."""
-        Jv, Jt = self.jacobian_rows[k], self.J_shift[k]
-        JtJv = Jt.T @ Jv
+    @property
+    def shift_columns(self) -> list[int]:
+        """The hand-eye translation columns: the corners' motion per rigid head displacement."""
+        return [self.columns.index(f"T_tool0_camera.{a}_m") for a in "xyz"]
+
+    def view_covariance_term(self, Jv: Array) -> Array:
+        """``J_v^T Σ_v J_v`` of a view's Jacobian ``Jv`` (the middle of the OLS sandwich)."""
+        JtJv = Jv[:, self.shift_columns].T @ Jv
         return self.sigma_px**2 * (Jv.T @ Jv) + self.repeatability_sigma_m**2 * (JtJv.T @ JtJv)
 
 
@@ -155,6 +164,31 @@ def _gls_block(Jv: Array, Jt: Array, sigma_px: float, sigma_rep_m: float) -> Arr
     return (G - B.T @ np.linalg.solve(k * np.eye(3) + C, B)) / sigma_px**2
 
 
+def _jacobians(
+    dh: DHTable,
+    state: State,
+    spec: TargetSpec,
+    cameras: Cameras,
+    cands: Candidates,
+    keep: list[int],
+    rows: Sequence[int],
+) -> tuple[list[Array], float]:
+    """The Jacobian row block (px per unit, columns ``keep``) of each candidate of ``rows`` by
+    :func:`cell.calibration.model.predict`, and its largest residual (px)."""
+    views = tuple(
+        CalibrationView(f"candidate {k}", cands.uv_left[k], cands.uv_right[k], q_rad=cands.q[k])
+        for k in rows
+    )
+    obs = CalibrationObservations(views, spec, cameras, source="calibration plan")
+    pred = predict(obs, dh, state, jac=True)
+    J = pred.jacobian[:, keep]
+    view_of_row = np.repeat(pred.view_index, 2)
+    order = np.argsort(view_of_row, kind="stable")
+    bounds = np.searchsorted(view_of_row[order], np.arange(len(views) + 1))
+    blocks = [J[order[bounds[v] : bounds[v + 1]]] for v in range(len(views))]
+    return blocks, float(np.abs(pred.residuals).max())
+
+
 def information_model(
     cell: CellConfig,
     target: TargetGeometry,
@@ -171,41 +205,33 @@ def information_model(
     cameras = Cameras.from_stereo(stereo)
     T_tcp_left = stereo_model(stereo).T_tcp_left
     state = _state(cell, target, cameras, T_tcp_left)
-    views = tuple(
-        CalibrationView(f"candidate {k}", cands.uv_left[k], cands.uv_right[k], q_rad=cands.q[k])
-        for k in range(len(cands))
-    )
-    obs = CalibrationObservations(views, target.spec(), cameras, source="calibration plan")
-    pred = predict(obs, dh, state, jac=True)
+    spec = target.spec()
     all_cols = column_names(True, True)
     fixed = {f"dh.{k}": v for k, v in structural_redundancies(dh).items()}
     keep = [i for i, c in enumerate(all_cols) if c not in fixed]
     columns = tuple(all_cols[i] for i in keep)
-    J = pred.jacobian[:, keep]
-    view_of_row = np.repeat(pred.view_index, 2)
-    order = np.argsort(view_of_row, kind="stable")
-    bounds = np.searchsorted(view_of_row[order], np.arange(len(cands) + 1))
-    rows = [J[order[bounds[v] : bounds[v + 1]]] for v in range(len(cands))]
     he = [columns.index(f"T_tool0_camera.{a}_m") for a in "xyz"]
-    shifts = [Jv[:, he] for Jv in rows]
-    blocks = np.array([_gls_block(Jv, Jt, sigma_px, repeatability_sigma_m)
-                       for Jv, Jt in zip(rows, shifts, strict=True)])  # fmt: skip
+    blocks, residual = [], 0.0
+    for lo in range(0, len(cands), CHUNK):
+        rows = range(lo, min(lo + CHUNK, len(cands)))
+        Js, res = _jacobians(dh, state, spec, cameras, cands, keep, rows)
+        residual = max(residual, res)
+        blocks += [_gls_block(Jv, Jv[:, he], sigma_px, repeatability_sigma_m) for Jv in Js]
     standoff = np.array([0.0, 0.0, cell.tool.standoff_m, 1.0])
     x_view = (invert(T_tcp_left) @ standoff)[:3]
     x_tcp = invert(T_tcp_left)[:3, 3]
     q = np.atleast_2d(np.asarray(stops_q, dtype=float))
     return InformationModel(
         columns=columns,
-        blocks=blocks,
-        jacobian_rows=rows,
-        J_shift=shifts,
+        blocks=np.array(blocks),
+        jacobians=lambda rows: _jacobians(dh, state, spec, cameras, cands, keep, rows)[0],
         H_view=point_sensitivity(dh, state, q, x_view)[:, :, keep],
         H_tcp=point_sensitivity(dh, state, q, x_tcp)[:, :, keep],
         fixed=fixed,
         prior=_prior(columns),
         sigma_px=sigma_px,
         repeatability_sigma_m=repeatability_sigma_m,
-        residual_px=float(np.abs(pred.residuals).max()),
+        residual_px=residual,
     )
 
 
@@ -220,9 +246,12 @@ def design_rows(
     (:func:`planner.calibration.choose_by_information`), and exchange from each of ``starts``;
     the best design wins."""
     W = _weight(model) if criterion == "tcp" else None
-    designs = [choose_by_information(model.blocks, n, model.prior, W)]
+    U = information_factors(model.blocks)
+    designs = [choose_by_information(model.blocks, n, model.prior, W, factors=U)]
     for start in starts:
-        designs.append(choose_by_information(model.blocks, n, model.prior, W, start=start))
+        designs.append(
+            choose_by_information(model.blocks, n, model.prior, W, start=start, factors=U)
+        )
     return min(designs, key=lambda r: design_value(model.blocks, r, model.prior, W))
 
 
@@ -234,7 +263,8 @@ def _rms_point_sigma(H: Array, cov: Array) -> float:
 def predict_sigmas(model: InformationModel, rows: list[int]) -> dict[str, Any]:
     """The predicted σ of the calibration from the views ``rows`` (module docstring): what
     ``caltour.json`` stores as ``calibration.prediction``."""
-    J = np.vstack([model.jacobian_rows[k] for k in rows])
+    Js = model.jacobians(rows)
+    J = np.vstack(Js)
     o = SolveOptions()
     try:
         report = choose_free(J, model.columns, {}, o.max_condition, o.effect_floor_px)
@@ -244,7 +274,7 @@ def predict_sigmas(model: InformationModel, rows: list[int]) -> dict[str, Any]:
     Jf = J[:, idx]
     _u, sv, vt = np.linalg.svd(Jf, full_matrices=False)
     inv = (vt.T / sv**2) @ vt  # (J_f^T J_f)^-1
-    middle = sum(model.view_covariance_term(k) for k in rows)[np.ix_(idx, idx)]
+    middle = sum(model.view_covariance_term(Jv) for Jv in Js)[np.ix_(idx, idx)]
     cov_f = inv @ middle @ inv
     cov = np.zeros((len(model.columns),) * 2)
     cov[np.ix_(idx, idx)] = cov_f

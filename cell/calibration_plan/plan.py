@@ -2,13 +2,14 @@
 
 1. Candidate views of the cell's calibration target (:func:`planner.calibration.candidate_views`):
    both cameras see the whole board at a good distance and tilt, IK within limits, no collision.
-2. A geometric pre-selection (:func:`planner.calibration.preselect`) of ``views`` views: large
-   rotations about axes far from parallel, features over both whole images, joints over the
-   range the hole tour uses (``joint_range``: its stops, widened by ``JOINT_RANGE_MARGIN_RAD``).
-3. The design (``criterion``): ``"geometric"`` keeps the pre-selection; ``"tcp"`` and ``"d"``
-   choose ``views`` of all candidates by the calibration adjustment's information
-   (:mod:`cell.calibration_plan.design`: greedy and exchange, and exchange from the
-   pre-selection; the better design wins), and every criterion predicts the parameters' σ.
+2. A geometric pre-selection (:func:`planner.calibration.preselect`), greedy, of ``views``
+   views: large rotations about axes far from parallel, features over both whole images,
+   joints over the range the hole tour uses (``joint_range``: its stops, widened by
+   ``JOINT_RANGE_MARGIN_RAD``): the geometric design.
+3. The design (``criterion``): ``"geometric"`` keeps that; ``"tcp"`` and ``"d"`` choose
+   ``views`` of every candidate by the calibration adjustment's information
+   (:mod:`cell.calibration_plan.design`: greedy and exchange, and exchange from the geometric
+   design; the better wins). Every criterion predicts the parameters' σ.
 4. The tour through them (:func:`planner.calibration.plan_view_tour`): the hole tour's GTSP,
    OMPL and ruckig machinery, so collision-free and jerk-limited.
 """

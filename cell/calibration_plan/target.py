@@ -23,13 +23,16 @@ from planner.calibration.tour import pose_dict
 @dataclass(frozen=True)
 class TargetGeometry:
     """A plate target: ``pattern`` (``chessboard`` or ``circles``), ``cols`` × ``rows``
-    features, ``pitch_m``, and ``T_cell_target`` (4×4, m) its nominal pose in the cell."""
+    features, ``pitch_m``, ``T_cell_target`` (4×4, m) its nominal pose in the cell (board frame:
+    :mod:`cell.config_target`), ``points_m`` (n, 3, m) the measured features in the board frame
+    (``None``: the nominal grid)."""
 
     pattern: str
     cols: int
     rows: int
     pitch_m: float
     T_cell_target: NDArray[np.float64]
+    points_m: NDArray[np.float64] | None = None
 
     def spec(self) -> TargetSpec:
         """The target as :mod:`measure.target` detects it."""
@@ -51,25 +54,21 @@ class TargetGeometry:
 
 def board_of(target: TargetGeometry) -> Board:
     """The planner's board of ``target``."""
-    return Board(
-        np.asarray(target.T_cell_target, dtype=float),
-        target.spec().object_points(),
-        name="calibration_target",
-    )
+    points = target.spec().object_points() if target.points_m is None else target.points_m
+    return Board(np.asarray(target.T_cell_target, dtype=float), points, "calibration_target")
 
 
 def cell_target(cell: CellConfig) -> TargetGeometry:
-    """The cell file's ``calibration_target``; a :class:`CellError` when it has none."""
-    spec = getattr(cell, "calibration_target", None)
-    if spec is None:
+    """The cell file's ``calibration_target`` (its measured corners when it names a file); a
+    :class:`CellError` when it has none."""
+    t = cell.calibration_target
+    if t is None:
         raise CellError(
             f"cell {cell.name!r}: calibration_target: missing; the cell file must place the "
             "calibration target (pattern, cols, rows, pitch_m, pose) to plan its views"
         )
-    return TargetGeometry(
-        pattern=str(spec.pattern),
-        cols=int(spec.cols),
-        rows=int(spec.rows),
-        pitch_m=float(spec.pitch_m),
-        T_cell_target=spec.pose.matrix(),
-    )
+    try:
+        points = t.board_points_m(cell.base_dir) if t.corners_file is not None else None
+    except ValueError as exc:
+        raise CellError(f"calibration_target.corners_file: {exc}") from exc
+    return TargetGeometry(t.pattern, t.cols, t.rows, t.pitch_m, t.T_cell_target(), points)

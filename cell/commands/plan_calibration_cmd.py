@@ -89,10 +89,24 @@ def summary(cal: CalibrationTour, path: Path) -> list[str]:
         f"{d['axis_eigen_min']:.2f}; image share {d['image_share']:.2f}; joint share "
         f"{d['joint_share']:.2f}",
     ]
-    for line in cal.prediction.get("summary_lines", []):
-        lines.append(f"predicted     {line}")
+    lines += prediction_lines(cal.prediction)
     lines.append(f"written       {path}")
     return lines
+
+
+def prediction_lines(p: dict) -> list[str]:
+    """The predicted σ of ``calibration.prediction`` as summary lines (mm, deg, µm)."""
+    if not p:
+        return []
+    return [
+        f"predicted σ   hand-eye {p['hand_eye_sigma_m'] * 1e3:.4f} mm, "
+        f"{np.degrees(p['hand_eye_sigma_rad']):.4f} deg; TCP {p['tcp_sigma_m'] * 1e6:.1f} um, "
+        f"view point {p['view_point_sigma_m'] * 1e6:.1f} um RMS at the hole tour's "
+        f"{p['stops']} stops",
+        f"              {len(p['sigma'])} parameters estimated, {len(p['fixed'])} fixed "
+        f"(condition {p['condition']:.0f}); corner noise {p['corner_sigma_px']:g} px, "
+        f"repeatability {p['repeatability_sigma_m'] * 1e6:.1f} um per axis",
+    ]
 
 
 def run_plan_calibration(args: argparse.Namespace) -> int:

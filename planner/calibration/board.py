@@ -3,8 +3,9 @@
 The planner never reads a cell file or a calibration file: the cell side builds these from its
 config (:mod:`cell.calibration_plan`) and hands them over as arrays and callables.
 
-Board frame (``target``): the plate's features lie in its x-y plane (z = 0), in detector order;
-the printed side faces +z, so a camera sees the board from the +z side.
+Board frame (``target``): OpenCV's board convention (``docs/conventions.md``): the features lie
+in its x-y plane (z = 0), in detector order, z points into the plate and the printed face faces
+-z, so a camera sees the board looking along +z.
 """
 
 from __future__ import annotations
@@ -56,8 +57,8 @@ class Board:
 
     @property
     def normal_cell(self) -> NDArray[np.float64]:
-        """The printed side's normal (the board's +z) in the cell frame."""
-        return np.asarray(self.T_cell_target, dtype=float)[:3, 2].copy()
+        """The printed face's outward normal (the board's -z) in the cell frame."""
+        return -np.asarray(self.T_cell_target, dtype=float)[:3, 2]
 
     @property
     def size_m(self) -> float:

@@ -1,6 +1,7 @@
 """Candidate calibration views: every feasible way for the arm to show the board to both cameras.
 
-A view direction is the board's inward normal (the TCP z axis along ``-normal``) tilted by each
+A view direction is the board's inward normal (the TCP z axis along the board's +z, into the
+printed face) tilted by each
 of ``tilts_deg`` toward ``azimuths`` directions in the board plane; the TCP sits at each of
 ``distances`` × ``standoff_m`` from the board's centre along it, rolled about it every
 ``roll_step_deg``, and shifted sideways in its own x-y plane by each of ``offsets`` ×
@@ -134,7 +135,7 @@ def sample_poses(board: Board, standoff_m: float, o: CandidateOptions) -> NDArra
     """Every sampled ``T_cell_tcp`` (p, 4, 4) looking at the board's centre (module docstring)."""
     T = np.asarray(board.T_cell_target, dtype=float)
     centre = T[:3, :3] @ board.centre_target + T[:3, 3]
-    inward = -T[:3, 2]
+    inward = T[:3, 2]  # into the printed face (planner.calibration.board)
     bx, by = T[:3, 0], T[:3, 1]
     dirs = []
     for tilt in np.radians(o.tilts_deg):
@@ -185,8 +186,8 @@ def _camera_view(
     if P[:, 2].min() < lo * standoff_m or P[:, 2].max() > hi * standoff_m:
         return "out of the depth of field", T_cam_target, np.zeros((0, 2)), 0.0
     sight = T_cam_target[:3, :3] @ board.centre_target + T_cam_target[:3, 3]
-    normal = T_cam_target[:3, 2]
-    cos = float(-(sight @ normal) / np.linalg.norm(sight))
+    into_plate = T_cam_target[:3, 2]  # the printed face looks along -z
+    cos = float((sight @ into_plate) / np.linalg.norm(sight))
     tilt = float(np.arccos(np.clip(cos, -1.0, 1.0)))
     if tilt > np.radians(o.max_tilt_deg):
         return "board seen too obliquely or from behind", T_cam_target, np.zeros((0, 2)), tilt

@@ -253,17 +253,19 @@ def choose_by_information(
     W: NDArray[np.float64] | None = None,
     exchange_passes: int = 10,
     start: list[int] | None = None,
+    factors: NDArray[np.float64] | None = None,
 ) -> list[int]:
     """Greedy then exchange choice of ``n`` of the views whose information blocks are
     ``blocks`` (m, p, p) (module docstring). ``prior`` (p, p): the information before any view
     (e.g. the parameters' prior σ^-2 on the diagonal, positive definite), which keeps the early
     steps regular.
     ``start``: ``n`` distinct rows to exchange from instead of the greedy choice. Returns rows
-    of ``blocks`` (greedy: in the order chosen)."""
+    of ``blocks`` (greedy: in the order chosen). ``factors``: :func:`information_factors` of
+    ``blocks``, when the caller has them (several designs from the same candidates)."""
     m = len(blocks)
     if n < 1 or n > m:
         raise PlanningError(f"cannot choose {n} calibration views from {m} candidates")
-    U = information_factors(blocks)
+    U = information_factors(blocks) if factors is None else factors
     M = np.asarray(prior, dtype=float).copy()
     if start is not None:
         chosen = [int(k) for k in start]

@@ -20,9 +20,11 @@ from cell.config import load_builtin_cell
 from cell.run.camera import cell_stereo
 from planner.calibration import candidate_views, preselect
 from robots.calibration import fk_with_errors
-from robots.transforms import make_transform
+from robots.transforms import make_transform, rpy_to_matrix
 
-TARGET = TargetGeometry("chessboard", 9, 7, 0.01, make_transform(np.eye(3), [0.9, -0.45, 0.381]))
+TARGET = TargetGeometry(
+    "chessboard", 9, 7, 0.01, make_transform(rpy_to_matrix([np.pi, 0, 0]), [0.9, -0.45, 0.381])
+)
 
 
 @pytest.fixture(scope="module")
@@ -98,7 +100,8 @@ def test_repeatability_enters_as_a_rigid_shift_per_view(setup) -> None:
     cell, stereo, _, cands, stops, model = setup
     rep = information_model(cell, TARGET, stereo, cands, stops, repeatability_sigma_m=11e-6)
     k = 5
-    Jv, Jt = rep.jacobian_rows[k], rep.J_shift[k]
+    Jv = rep.jacobians([k])[0]
+    Jt = Jv[:, rep.shift_columns]
     cov = rep.sigma_px**2 * np.eye(len(Jv)) + rep.repeatability_sigma_m**2 * Jt @ Jt.T
     direct = Jv.T @ np.linalg.solve(cov, Jv)
     assert np.allclose(rep.blocks[k], direct, rtol=1e-6, atol=1e-6 * np.abs(direct).max())

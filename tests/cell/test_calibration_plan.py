@@ -12,10 +12,12 @@ from cell.errors import CellError
 from cell.run.camera import cell_stereo
 from planner import Options
 from planner.calibration import load_caltour
-from robots.transforms import make_transform
+from robots.transforms import make_transform, rpy_to_matrix
 
 #: a target we place ourselves: flat on the fixture table beside the part
-TARGET = TargetGeometry("chessboard", 9, 7, 0.01, make_transform(np.eye(3), [0.9, -0.45, 0.381]))
+TARGET = TargetGeometry(
+    "chessboard", 9, 7, 0.01, make_transform(rpy_to_matrix([np.pi, 0, 0]), [0.9, -0.45, 0.381])
+)
 
 
 @pytest.fixture(scope="module")

@@ -33,6 +33,8 @@ from robots.transforms import invert, make_transform, rpy_to_matrix
 
 #: a board we place ourselves: flat on the fixture table, beside the part, printed side up
 BOARD_XYZ = (0.9, -0.45, 0.381)
+#: the board frame looks into the plate (OpenCV): printed face up is a half-turn about x
+FACE_UP = rpy_to_matrix([np.pi, 0.0, 0.0])
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +43,7 @@ def setup():
     arm = cell.build_arm()
     head = stereo_model(standard_stereo())
     spec = TargetSpec("chessboard", 9, 7, 0.01)
-    board = Board(make_transform(np.eye(3), BOARD_XYZ), spec.object_points())
+    board = Board(make_transform(FACE_UP, BOARD_XYZ), spec.object_points())
     cands = candidate_views(arm, board, head, cell.tool.standoff_m, cell.home_q())
     return cell, arm, head, board, cands
 
@@ -77,7 +79,7 @@ def test_every_candidate_shows_the_whole_board_to_both_cameras(setup) -> None:
 def test_a_board_facing_away_has_no_view_and_says_why(setup) -> None:
     cell, arm, head, _, _ = setup
     spec = TargetSpec("chessboard", 9, 7, 0.01)
-    down = Board(make_transform(rpy_to_matrix([np.pi, 0, 0]), BOARD_XYZ), spec.object_points())
+    down = Board(make_transform(np.eye(3), BOARD_XYZ), spec.object_points())
     with pytest.raises(NoCalibrationViewError, match="calibration_target: no feasible") as exc:
         candidate_views(arm, down, head, cell.tool.standoff_m, cell.home_q())
     assert exc.value.reasons  # counted by reason (inside the table, behind the board, ...)
