@@ -239,6 +239,11 @@ def _weight(model: InformationModel) -> Array:
     return np.einsum("sia,sib->ab", model.H_view, model.H_view)
 
 
+#: exchange passes of the information design (greedy alone is within 3 % of ten passes' value
+#: on the built-in cell, three within 0.1 %)
+EXCHANGE_PASSES = 3
+
+
 def design_rows(
     model: InformationModel, n: int, criterion: str, starts: list[list[int]]
 ) -> list[int]:
@@ -247,10 +252,11 @@ def design_rows(
     the best design wins."""
     W = _weight(model) if criterion == "tcp" else None
     U = information_factors(model.blocks)
-    designs = [choose_by_information(model.blocks, n, model.prior, W, factors=U)]
+    passes = EXCHANGE_PASSES
+    designs = [choose_by_information(model.blocks, n, model.prior, W, passes, factors=U)]
     for start in starts:
         designs.append(
-            choose_by_information(model.blocks, n, model.prior, W, start=start, factors=U)
+            choose_by_information(model.blocks, n, model.prior, W, passes, start, factors=U)
         )
     return min(designs, key=lambda r: design_value(model.blocks, r, model.prior, W))
 

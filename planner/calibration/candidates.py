@@ -162,13 +162,21 @@ def sample_poses(board: Board, standoff_m: float, o: CandidateOptions) -> NDArra
     return np.array(poses)
 
 
-def hull_share(uv: NDArray[np.float64], image_size: tuple[int, int]) -> float:
-    """The features' convex hull area as a share of the image area (0 for a degenerate hull)."""
-    try:
-        area = ConvexHull(uv).volume  # the "volume" of a 2-D hull is its area
-    except QhullError:
-        return 0.0
-    return float(area / (image_size[0] * image_size[1]))
+def hull_vertices(points_target: NDArray[np.float64]) -> NDArray[np.int64]:
+    """Indices of the board's features on their convex hull (board plane), in order. A camera
+    in front of the plane keeps that hull and its order (a perspective map preserves convexity;
+    the lens's distortion bends the edges by a fraction of a pixel)."""
+    return np.asarray(ConvexHull(np.asarray(points_target)[:, :2]).vertices, dtype=np.int64)
+
+
+def hull_share(
+    uv: NDArray[np.float64], image_size: tuple[int, int], vertices: NDArray[np.int64]
+) -> float:
+    """The features' convex hull area (``uv[vertices]``, the shoelace formula) as a share of
+    the image area."""
+    x, y = uv[vertices, 0], uv[vertices, 1]
+    area = 0.5 * abs(float(x @ np.roll(y, -1) - y @ np.roll(x, -1)))
+    return area / (image_size[0] * image_size[1])
 
 
 def _camera_view(
@@ -260,6 +268,10 @@ def candidate_views(
     if not kept:
         raise NoCalibrationViewError(board.name, dict(refused))
     size = stereo.image_size
+    try:
+        vertices = hull_vertices(board.points_target)
+    except QhullError as exc:
+        raise PlanningError(f"{board.name}: the features do not span the plane") from exc
     out = Candidates(
         T_cell_tcp=np.array([k[0] for k in kept]),
         q=np.array([k[1] for k in kept]),
@@ -270,7 +282,7 @@ def candidate_views(
         uv_left=np.array([k[4][0][1] for k in kept]),
         uv_right=np.array([k[4][1][1] for k in kept]),
         tilt_rad=np.array([max(k[4][0][2], k[4][1][2]) for k in kept]),
-        coverage=np.array([[hull_share(k[4][c][1], size) for c in (0, 1)] for k in kept]),
+        coverage=np.array([[hull_share(k[4][c][1], size, vertices) for c in (0, 1)] for k in kept]),
         refused=dict(refused),
     )
     log.info("%s: %d candidate views (%s refused)", board.name, len(out), dict(refused))

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import yaml
 
 from cell.calibration_plan.plan import CalibrationPlanOptions, joint_range, plan_calibration
 from cell.calibration_plan.target import TargetGeometry
-from cell.config import load_builtin_cell
+from cell.cli import main
+from cell.config import builtin_cell_path, load_builtin_cell
 from cell.errors import CellError
 from cell.run.camera import cell_stereo
 from planner import Options
@@ -50,3 +52,26 @@ def test_bad_options_are_refused() -> None:
         CalibrationPlanOptions(criterion="e")
     with pytest.raises(CellError, match="corner_sigma_px"):
         CalibrationPlanOptions(corner_sigma_px=0.0)
+
+
+def test_cli_plans_the_builtin_cells_tour(tmp_path, capsys) -> None:
+    out = tmp_path / "caltour.json"
+    assert main(["plan-calibration", "-o", str(out), "--views", "4", "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "robot time" in text and "predicted σ   hand-eye" in text
+    cal = load_caltour(out)
+    assert len(cal.tour.stops) == 4 and cal.design["criterion"] == "tcp"
+    assert cal.prediction["hand_eye_sigma_m"] > 0 and cal.prediction["stops"] > 0
+    assert cal.target["cols"] == 9 and cal.target["rows"] == 6
+
+
+def test_cli_refuses_a_cell_without_a_target(tmp_path, capsys) -> None:
+    data = yaml.safe_load(builtin_cell_path().read_text())
+    del data["calibration_target"]
+    cell = tmp_path / "cell.yaml"
+    cell.write_text(yaml.safe_dump(data))
+    out = tmp_path / "caltour.json"
+    assert main(["plan-calibration", str(cell), "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "calibration_target: missing" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
