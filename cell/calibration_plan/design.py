@@ -25,9 +25,10 @@ comparable; the predicted σ are without it.
 
 **Predicted σ**: for the chosen views, which unknowns the adjustment would estimate
 (:func:`cell.calibration.identifiability.choose_free` on their Jacobian, the adjustment's own
-rule) and the covariance of its estimate: the adjustment is ordinary least squares, so
-``(J_f^T J_f)^-1 (sum_v J_v^T Σ_v J_v) (J_f^T J_f)^-1`` (equal to ``σ_px² (J_f^T J_f)^-1``
-without repeatability); from it the σ of the hand-eye, and of the
+rule) and the covariance of its estimate: the adjustment whitens each view's residuals by its
+flange scatter (generalised least squares, ``cell.calibration.solve``), so
+``(sum_v J_v^T Σ_v^-1 J_v)^-1`` over the free unknowns (``σ_px² (J_f^T J_f)^-1`` without
+repeatability); from it the σ of the hand-eye, and of the
 TCP and the view point at the hole tour's stops (RMS over the stops of ``sqrt(trace(H Σ H^T))``).
 """
 
@@ -97,11 +98,6 @@ class InformationModel:
     def shift_columns(self) -> list[int]:
         """The hand-eye translation columns: the corners' motion per rigid head displacement."""
         return [self.columns.index(f"T_tool0_camera.{a}_m") for a in "xyz"]
-
-    def view_covariance_term(self, Jv: Array) -> Array:
-        """``J_v^T Σ_v J_v`` of a view's Jacobian ``Jv`` (the middle of the OLS sandwich)."""
-        JtJv = Jv[:, self.shift_columns].T @ Jv
-        return self.sigma_px**2 * (Jv.T @ Jv) + self.repeatability_sigma_m**2 * (JtJv.T @ JtJv)
 
 
 def _dh(cell: CellConfig) -> DHTable:
@@ -269,19 +265,16 @@ def _rms_point_sigma(H: Array, cov: Array) -> float:
 def predict_sigmas(model: InformationModel, rows: list[int]) -> dict[str, Any]:
     """The predicted σ of the calibration from the views ``rows`` (module docstring): what
     ``caltour.json`` stores as ``calibration.prediction``."""
-    Js = model.jacobians(rows)
-    J = np.vstack(Js)
+    J = np.vstack(model.jacobians(rows))
     o = SolveOptions()
     try:
         report = choose_free(J, model.columns, {}, o.max_condition, o.effect_floor_px)
     except DegenerateCalibrationError as exc:
         raise CellError(f"the chosen calibration views are degenerate: {exc}") from exc
     idx = [model.columns.index(c) for c in report.free]
-    Jf = J[:, idx]
-    _u, sv, vt = np.linalg.svd(Jf, full_matrices=False)
-    inv = (vt.T / sv**2) @ vt  # (J_f^T J_f)^-1
-    middle = sum(model.view_covariance_term(Jv) for Jv in Js)[np.ix_(idx, idx)]
-    cov_f = inv @ middle @ inv
+    info = model.blocks[list(rows)].sum(axis=0)[np.ix_(idx, idx)]
+    norms = np.sqrt(np.diag(info))  # columns scaled to one before inverting (m against rad)
+    cov_f = np.linalg.inv(info / np.outer(norms, norms)) / np.outer(norms, norms)
     cov = np.zeros((len(model.columns),) * 2)
     cov[np.ix_(idx, idx)] = cov_f
     sigma = {c: float(np.sqrt(cov_f[i, i])) for i, c in enumerate(report.free)}
