@@ -27,7 +27,7 @@ def cell():
     return load_builtin_cell()
 
 
-def test_geometric_plan_of_a_placed_target(cell, tmp_path) -> None:
+def test_geometric_plan_of_a_placed_target(cell, tmp_path, capsys) -> None:
     stops = np.array([cell.home_q(), cell.home_q() + 0.3])
     o = CalibrationPlanOptions(views=5, criterion="geometric", tour=Options(seed=1))
     cal = plan_calibration(cell, TARGET, cell_stereo(cell), stops, o)
@@ -39,6 +39,11 @@ def test_geometric_plan_of_a_placed_target(cell, tmp_path) -> None:
     back = load_caltour(cal.save(tmp_path / "caltour.json"))
     assert back.target["pattern"] == "chessboard" and back.target["cols"] == 9
     assert {v["id"] for v in back.views} == {s.hole_id for s in back.tour.stops}
+    # a calibration tour is no hole tour: its stops are no holes of the cell
+    hole_tour = cal.tour.save(tmp_path / "tour.json")
+    args = ["plan-calibration", "-o", str(tmp_path / "c.json"), "--tour", str(hole_tour)]
+    assert main([*args, "--quiet"]) == 2
+    assert "CAL01" in capsys.readouterr().err
 
 
 def test_more_views_than_feasible_are_refused(cell) -> None:
