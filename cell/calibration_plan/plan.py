@@ -68,7 +68,7 @@ class CalibrationPlanOptions:
     resolution, ...).
     """
 
-    views: int = 60
+    views: int = 120
     criterion: str = "tcp"
     predict: bool = True
     corner_sigma_px: float = CORNER_SIGMA_PX
