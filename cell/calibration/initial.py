@@ -112,17 +112,22 @@ def _candidate(method: str, X: Array, T_bt: Array, T_ct: Array, t0: float) -> Ha
     return HandEyeCandidate(method, X, mean_pose(Ys), sp_m, sp_r, time.perf_counter() - t0)
 
 
+def _mats(A: Array) -> list[Array]:
+    """OpenCV's input: a list of contiguous 3x3 rotations or 3x1 translations."""
+    return [np.ascontiguousarray(a, dtype=np.float64) for a in A]
+
+
 def hand_eye_candidates(
     T_base_tool0: Array, T_camera_target: Array
 ) -> tuple[HandEyeCandidate, ...]:
     """Every OpenCV hand-eye solution of the pose pairs (k, 4, 4) each."""
     out = []
-    Rg, tg = T_base_tool0[:, :3, :3], T_base_tool0[:, :3, 3]
-    Rc, tc = T_camera_target[:, :3, :3], T_camera_target[:, :3, 3]
+    Rg, tg = _mats(T_base_tool0[:, :3, :3]), _mats(T_base_tool0[:, :3, 3:4])
+    Rc, tc = _mats(T_camera_target[:, :3, :3]), _mats(T_camera_target[:, :3, 3:4])
     for name, flag in HAND_EYE_METHODS.items():
         t0 = time.perf_counter()
         try:
-            R, t = cv2.calibrateHandEye(list(Rg), list(tg), list(Rc), list(tc), method=flag)
+            R, t = cv2.calibrateHandEye(Rg, tg, Rc, tc, method=flag)
             X = _to_T(R, t)
         except cv2.error:
             X = np.full((4, 4), np.nan)
@@ -132,10 +137,10 @@ def hand_eye_candidates(
         t0 = time.perf_counter()
         try:
             _Rw, _tw, R_c_g, t_c_g = cv2.calibrateRobotWorldHandEye(
-                list(Rc),
-                list(tc),
-                list(T_tool0_base[:, :3, :3]),
-                list(T_tool0_base[:, :3, 3]),
+                Rc,
+                tc,
+                _mats(T_tool0_base[:, :3, :3]),
+                _mats(T_tool0_base[:, :3, 3:4]),
                 method=flag,
             )
             X = np.linalg.inv(_to_T(R_c_g, t_c_g))

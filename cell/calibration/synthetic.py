@@ -10,7 +10,7 @@ camera 0.2 mm and 0.02 deg.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -139,11 +139,16 @@ def simulate(
     seed: int = 0,
     with_joints: bool = True,
     source: str = "<synthetic>",
+    flange_sigma_m: float = 0.0,
+    flange_sigma_rad: float = 0.0,
 ) -> CalibrationObservations:
     """Observations of the views ``q_rad`` (V, 6): exact corners plus N(0, noise_px) noise;
     an image where a corner falls outside holds ``None`` (target not seen).
 
     ``with_joints=False`` gives the true flange poses instead of the joints (no kinematics).
+    ``flange_sigma_m``, ``flange_sigma_rad``: each view's flange is off by that much more (per
+    axis, position and rotation about the flange's origin: the arm's repeatability), which the
+    observations do not report.
     """
     rng = np.random.default_rng(seed)
     M = len(truth.target.object_points())
@@ -158,11 +163,18 @@ def simulate(
                 q_rad=np.asarray(q_rad[i], float),
             )
         )
+    T_bt = fk_with_errors(truth.dh, truth.truth.delta, q_rad)
+    T_seen = T_bt.copy()
+    if flange_sigma_m > 0 or flange_sigma_rad > 0:
+        for i in range(V):
+            dR = Rotation.from_rotvec(rng.normal(0.0, flange_sigma_rad, 3)).as_matrix()
+            T_seen[i, :3, :3] = dR @ T_bt[i, :3, :3]
+            T_seen[i, :3, 3] = T_bt[i, :3, 3] + rng.normal(0.0, flange_sigma_m, 3)
+    views = [replace(v, q_rad=None, T_base_tool0=T_seen[i]) for i, v in enumerate(views)]
     blank = CalibrationObservations(tuple(views), truth.target, truth.cameras, source)
-    pred = predict(blank, truth.dh, truth.truth, jac=False)
+    pred = predict(blank, None, truth.truth, jac=False)
     exact = pred.residuals.reshape(-1, M, 2)  # corners minus zero
     n_left = V
-    T_bt = fk_with_errors(truth.dh, truth.truth.delta, q_rad)
     out = []
     w, h = truth.cameras.left.image_size
 
@@ -241,3 +253,41 @@ def reference_joints(truth: SyntheticTruth, standoff_m: float = 0.25) -> Array:
     if not ik.ok:
         raise ValueError(f"the straight view is out of reach: {ik.reason}")
     return ik.solutions[np.argmin(np.linalg.norm(ik.solutions, axis=1))]
+
+
+def truth_in_gauge(truth: SyntheticTruth) -> State:
+    """The truth as the calibration can see it: the structurally redundant D-H terms folded
+    into the target's and the camera's poses (``robots.calibration.redundancy.fold_redundant``)."""
+    from robots.calibration.redundancy import fold_redundant
+
+    delta, C, E = fold_redundant(truth.dh, truth.truth.delta)
+    return State(
+        T_tool0_camera=E @ truth.truth.T_tool0_camera,
+        T_base_target=np.linalg.inv(C) @ truth.truth.T_base_target,
+        T_left_right=truth.truth.T_left_right,
+        delta=delta,
+    )
+
+
+def parameter_errors(cal, truth: State) -> dict[str, float]:
+    """Estimate minus truth of every free parameter of a calibration (m, rad), in the
+    calibration's perturbation (position difference; rotation vector of ``R_est R_true^T``)."""
+    from robots.calibration import term_names
+
+    out: dict[str, float] = {}
+    poses = {
+        "T_tool0_camera": (cal.T_tool0_camera.T, truth.T_tool0_camera),
+        "T_base_target": (cal.T_base_target.T, truth.T_base_target),
+    }
+    if cal.T_left_right is not None and truth.T_left_right is not None:
+        poses["T_left_right"] = (cal.T_left_right.T, truth.T_left_right)
+    for prefix, (est, true) in poses.items():
+        dv = est[:3, 3] - true[:3, 3]
+        dw = Rotation.from_matrix(est[:3, :3] @ true[:3, :3].T).as_rotvec()
+        for c, v in zip(
+            ("x_m", "y_m", "z_m", "rx_rad", "ry_rad", "rz_rad"), (*dv, *dw), strict=True
+        ):
+            out[f"{prefix}.{c}"] = float(v)
+    for k, n in enumerate(term_names()):
+        out[f"dh.{n}"] = float(cal.delta[k] - truth.delta[k])
+    return {n: out[n] for n in cal.parameter_names}
