@@ -146,6 +146,8 @@ def camera_board_poses(v: Views, K: np.ndarray, dist: np.ndarray) -> list[np.nda
     out = []
     for obj, img in zip(v.obj, v.img, strict=True):
         ok, rvec, tvec = cv2.solvePnP(obj, img, K, dist, flags=cv2.SOLVEPNP_ITERATIVE)
+        if not ok:
+            raise RuntimeError("solvePnP failed on a view whose board was found")
         out.append(pose_matrix(cv2.Rodrigues(rvec)[0], tvec))
     return out
 
@@ -239,3 +241,27 @@ def consistency(v: Views, X: np.ndarray, T_cam_board: list[np.ndarray]) -> tuple
     mean = board_in_base(v, X, T_cam_board)
     d = [difference(T @ X @ C, mean) for T, C in zip(v.T_base_tool0, T_cam_board, strict=True)]
     return float(np.mean([r for _, r in d])), float(np.mean([t for t, _ in d]))
+
+
+def _pose_params(T: np.ndarray) -> np.ndarray:
+    return np.concatenate([Rotation.from_matrix(T[:3, :3]).as_rotvec(), T[:3, 3]])
+
+
+def _params_pose(p: np.ndarray) -> np.ndarray:
+    return pose_matrix(Rotation.from_rotvec(p[:3]).as_matrix(), p[3:])
+
+
+def joint_refinement(
+    v: Views, X0: np.ndarray, T_base_board0: np.ndarray, K, dist
+) -> tuple[np.ndarray, np.ndarray]:
+    """``X`` and ``T_base_board`` together by least squares on the reprojection error of all
+    corners (SciPy, Levenberg-Marquardt, intrinsics and robot poses fixed): the reprojection
+    formulation of AX = ZB, a reference for sets whose authors publish no transform."""
+
+    def fun(p: np.ndarray) -> np.ndarray:
+        return _project(v, _params_pose(p[:6]), _params_pose(p[6:]), K, dist)
+
+    sol = least_squares(
+        fun, np.concatenate([_pose_params(X0), _pose_params(T_base_board0)]), method="lm"
+    )
+    return _params_pose(sol.x[:6]), _params_pose(sol.x[6:])

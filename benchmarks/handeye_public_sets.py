@@ -36,11 +36,12 @@ from scipy.spatial.transform import Rotation
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-import handeye_opencv_baseline as cvb  # noqa: E402
-from handeye_sets_io import (  # noqa: E402
+import handeye_opencv_baseline as cvb
+from handeye_sets_io import (
     Board,
     DataSetError,
     pose_matrix,
+    quat_xyzw,
     read_intrinsics,
     read_poses_csv,
     read_set,
@@ -139,6 +140,10 @@ def compare(out: Path, holecell: list[str]) -> int:
             },
             **answers,
         }
+    if cvb.is_valid(answers["PARK"]["X"]):
+        X0 = answers["PARK"]["X"]
+        X, Tb = cvb.joint_refinement(views, X0, cvb.board_in_base(views, X0, T_cb), K, dist)
+        answers["reproj-LM"] = {"X": X, "base_board": Tb}
     for i, path in enumerate(holecell):
         answers[f"holecell{'' if i == 0 else i}"] = {"X": read_holecell(path), "base_board": None}
     ref = np.array(pub) if pub is not None else None
@@ -168,6 +173,7 @@ def compare(out: Path, holecell: list[str]) -> int:
         )
         rows[name] = {
             "t_mm": t.tolist(),
+            "quat_xyzw": quat_xyzw(X[:3, :3]).tolist(),
             "dt_mm": dt,
             "dR_deg": dR,
             "rms_px": rms,
