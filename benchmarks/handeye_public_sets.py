@@ -12,7 +12,8 @@ The data are not in the repository; fetch them into a scratch folder and pass th
    ``holecell calibrate hand-eye`` command for it.
 2. ``compare OUT [--holecell FILE ...]``: read ``OUT`` back (so the OpenCV column sees exactly
    what the CLI sees), run every OpenCV method (``handeye_opencv_baseline``) and print, per
-   answer, the difference to the published one (mm, deg), the reprojection RMS on the views and
+   answer, the difference to the published one (mm, deg; to OpenCV's PARK where the authors
+   publish no transform), the reprojection RMS on the views and
    ViSP's consistency residual. ``--holecell`` adds the CLI's answer (a YAML/JSON file holding
    ``T_tool0_camera: {xyz, quat_xyzw}``).
 
@@ -146,7 +147,10 @@ def compare(out: Path, holecell: list[str]) -> int:
         answers["reproj-LM"] = {"X": X, "base_board": Tb}
     for i, path in enumerate(holecell):
         answers[f"holecell{'' if i == 0 else i}"] = {"X": read_holecell(path), "base_board": None}
-    ref = np.array(pub) if pub is not None else None
+    # differences against the published answer; a set without one is compared with PARK's
+    ref_name = "published" if pub is not None else "PARK"
+    ref = answers[ref_name]["X"] if cvb.is_valid(answers[ref_name]["X"]) else None
+    print(f"dt, dR against: {ref_name}")
     print(f"{meta['name']}: {len(views.names)} views used of {meta['views']}")
     print(
         f"{'answer':<12} {'x mm':>8} {'y mm':>8} {'z mm':>8} {'dt mm':>7} {'dR deg':>7} "
