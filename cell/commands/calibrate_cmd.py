@@ -1,122 +1,58 @@
-"""``holecell calibrate``: stereo calibration from image pairs of a plate target."""
+"""``holecell calibrate``: the calibrations, one subcommand module each.
+
+``calibrate stereo`` (:mod:`cell.commands.calibrate_stereo_cmd`) calibrates the stereo head;
+``calibrate hand-eye`` (:mod:`cell.commands.calibrate_handeye_cmd`) the head on the flange,
+the target in the base, the arm's D-H errors and the stereo extrinsics from recorded data.
+The older form ``holecell calibrate --left ... --right ...`` is the stereo calibration.
+A new calibration is one more module in :data:`CALIBRATE_MODULES` with a ``register(sub)``.
+"""
 
 from __future__ import annotations
 
 import argparse
-import glob
-from pathlib import Path
+import importlib
 
-import numpy as np
+from cell.commands import calibrate_stereo_cmd
+from cell.errors import CellError
 
-from cell.commands.measure_cmd import read_image
-from measure.errors import CalibrationTargetError
-from measure.stereo_calibrate import CalibrateOptions, calibrate_stereo
-from measure.target import TargetSpec
+#: the ``calibrate`` subcommands' modules under ``cell.commands``, in ``--help`` order
+CALIBRATE_MODULES: tuple[str, ...] = ("calibrate_stereo_cmd", "calibrate_handeye_cmd")
 
 
-def _expand(items: list[str]) -> list[str]:
-    out: list[str] = []
-    for item in items:
-        hits = sorted(glob.glob(item)) if any(c in item for c in "*?[") else [item]
-        out.extend(hits)
-    return out
+class CalibrateUsageError(CellError):
+    """``holecell calibrate`` without a subcommand and without the old form's options."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add the ``calibrate`` subcommand."""
+    """Add the ``calibrate`` subcommand and its own subcommands."""
     p = sub.add_parser(
         "calibrate",
-        help="stereo calibration from image pairs of a plate target",
+        help="calibrations: stereo head (stereo), hand-eye and kinematics (hand-eye)",
         description=(
-            "Reads pairs of left/right images of a chessboard or asymmetric circle grid "
-            "(paired in sorted order), rejects unusable pairs with a reason, calibrates both "
-            "cameras and their pose, prints the RMS and per-pair reprojection errors and "
-            "writes stereo.json with the parameters' standard deviations (only when the "
-            "calibration succeeds). Refuses (exit 2, nothing written) a board with more "
-            "corners than --cols/--rows, a square side that looks like millimetres and a "
-            "baseline outside 10 mm - 2 m; names pairs whose error is above 3x the median."
+            "Calibrations from images of a plate target. 'calibrate stereo' calibrates the "
+            "stereo head; 'calibrate hand-eye' the head on the flange, the target in the base, "
+            "the arm's D-H errors and the stereo extrinsics from images and robot poses "
+            "recorded elsewhere. Without a subcommand, --left/--right run the stereo "
+            "calibration (the older form): " + calibrate_stereo_cmd.DESCRIPTION
         ),
     )
-    p.add_argument("--left", nargs="+", required=True, help="left images (files or a glob)")
-    p.add_argument("--right", nargs="+", required=True, help="right images (files or a glob)")
-    p.add_argument("--pattern", choices=("chessboard", "circles"), default="chessboard")
-    p.add_argument("--cols", type=int, required=True, help="inner corners / circles per row")
-    p.add_argument("--rows", type=int, required=True, help="inner corner / circle rows")
-    p.add_argument("--pitch", type=float, required=True, help="square side / grid pitch (metres)")
-    p.add_argument("-o", "--output", default="stereo.json", help="file to write (stereo.json)")
-    p.add_argument(
-        "--drop-outliers",
-        action="store_true",
-        help="drop pairs above 3x the median reprojection error and calibrate again",
-    )
-    p.add_argument(
-        "--bootstrap",
-        type=int,
-        default=100,
-        metavar="N",
-        help="resample the pairs N times for the standard deviations (0: Jacobian only)",
-    )
-    p.add_argument(
-        "--force",
-        action="store_true",
-        help="write stereo.json even when a check refuses it (the problems are still printed)",
-    )
-    p.set_defaults(handler=run)
+    calibrate_stereo_cmd.add_arguments(p, required=False)
+    inner = p.add_subparsers(dest="calibrate_command", metavar="WHAT")
+    for name in CALIBRATE_MODULES:
+        importlib.import_module(f"cell.commands.{name}").register(inner)
+    p.set_defaults(handler=_older_form)
 
 
-def run(args: argparse.Namespace) -> int:
-    """Handler: detect, calibrate, report, write."""
-    lefts, rights = _expand(args.left), _expand(args.right)
-    if not lefts or len(lefts) != len(rights):
-        raise CalibrationTargetError(
-            f"need the same number of left and right images, got {len(lefts)} and {len(rights)}", []
+def _older_form(args: argparse.Namespace) -> int:
+    """``holecell calibrate --left ... --right ...``: the stereo calibration."""
+    missing = [
+        f"--{name}"
+        for name in ("left", "right", "cols", "rows", "pitch")
+        if getattr(args, name) is None
+    ]
+    if missing:
+        raise CalibrateUsageError(
+            "give a subcommand (stereo, hand-eye) or the stereo calibration's options; missing: "
+            + ", ".join(missing)
         )
-    try:
-        spec = TargetSpec(args.pattern, args.cols, args.rows, args.pitch)
-    except ValueError as exc:
-        raise CalibrationTargetError(str(exc), []) from None
-    pairs = []
-    for lp, rp in zip(lefts, rights, strict=True):
-        name = f"{Path(lp).name} / {Path(rp).name}"
-        pairs.append((name, read_image(lp, "left"), read_image(rp, "right")))
-    opts = CalibrateOptions(drop_outliers=args.drop_outliers, bootstrap=max(args.bootstrap, 0))
-    res = calibrate_stereo(pairs, spec, opts)
-    errors = dict(res.per_pair_px)
-    reasons = dict(res.rejected)
-    width = max(len(n) for n, _, _ in pairs)
-    for name, _, _ in pairs:
-        if name in errors:
-            status = f"{errors[name]:.3f} px"
-            retried = [
-                f"{side}: {det}"
-                for side, det in zip(("left", "right"), res.detectors[name], strict=True)
-                if det != "fast" and spec.kind == "chessboard"
-            ]
-            if retried:
-                status += f"  (detector {', '.join(retried)})"
-        else:
-            status = f"rejected: {reasons[name]}"
-        print(f"{name:<{width}}  {status}")
-    st = res.stereo
-    u = st.uncertainty
-    print(f"RMS reprojection error {res.rms_px:.3f} px over {len(errors)} pairs")
-    f_l, f_r = st.K_left[0, 0], st.K_right[0, 0]
-    if u is not None:
-        b_std = float(np.sqrt(np.sum((st.T / st.baseline_m * u.T_std_m) ** 2)))
-        print(
-            f"baseline {st.baseline_m * 1e3:.3f} ± {b_std * 1e3:.3f} mm, "
-            f"f = {f_l:.1f} ± {u.K_std_left_px[0]:.2f} / {f_r:.1f} ± {u.K_std_right_px[0]:.2f} px"
-            f" (1 sigma, {u.method})"
-        )
-    for prob in res.problems:
-        print(f"{'refused' if prob.refuse else 'warning'}: {prob.message}")
-    if res.refused and not args.force:
-        raise CalibrationTargetError(
-            f"not written ({args.output}): "
-            + "; ".join(p.kind.replace("_", " ") for p in res.refused)
-            + " (see above; --force writes it anyway)",
-            [],
-        )
-    st.save(args.output)
-    print(f"wrote {args.output}")
-    return 0
+    return calibrate_stereo_cmd.run(args)

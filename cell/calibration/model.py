@@ -1,0 +1,186 @@
+"""The observation model of the cell calibration: predicted corners and their Jacobian.
+
+A corner ``p`` of the target (plate frame, m) seen in view ``v``::
+
+    X_left  = inv(T_base_tool0(q_v; delta) @ T_tool0_camera) @ T_base_target @ p
+    X_right = inv(T_left_right) @ X_left
+    pixel   = OpenCV projection with the camera's K and distortion (cv2.projectPoints)
+
+Unknowns (:class:`State`): ``T_tool0_camera``, ``T_base_target``, ``T_left_right`` (stereo) and
+the D-H error vector ``delta`` (:mod:`robots.calibration`). A pose is perturbed as
+``R = exp([w]) R0, t = t0 + v``: six columns ``(vx, vy, vz)`` m and ``(wx, wy, wz)`` rad, the
+rotation vector in the parent frame (``base_link`` for the target, ``tool0`` for the camera,
+``left`` for the right camera). Jacobian columns, in this order: hand-eye (6), target (6),
+stereo extrinsics (6, stereo heads only), the 24 D-H terms (views with joints only).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from cell.calibration.observations import CalibrationObservations, Intrinsics
+from robots.calibration import dh_error_twists, fk_with_errors, term_names
+from robots.dh import DHTable
+
+Array = NDArray[np.float64]
+
+POSE_COLUMNS = ("x_m", "y_m", "z_m", "rx_rad", "ry_rad", "rz_rad")
+
+
+@dataclass(frozen=True, eq=False)
+class State:
+    """Current values of the unknowns (4x4 poses in metres, ``delta`` (24,))."""
+
+    T_tool0_camera: Array
+    T_base_target: Array
+    T_left_right: Array | None
+    delta: Array
+
+
+def column_names(stereo: bool, kinematic: bool) -> tuple[str, ...]:
+    """Names of the Jacobian's columns (see the module docstring)."""
+    names = [f"T_tool0_camera.{c}" for c in POSE_COLUMNS]
+    names += [f"T_base_target.{c}" for c in POSE_COLUMNS]
+    if stereo:
+        names += [f"T_left_right.{c}" for c in POSE_COLUMNS]
+    if kinematic:
+        names += [f"dh.{n}" for n in term_names()]
+    return tuple(names)
+
+
+def _skew(v: Array) -> Array:
+    """Skew matrices (..., 3, 3) of vectors (..., 3)."""
+    S = np.zeros((*v.shape[:-1], 3, 3))
+    S[..., 0, 1], S[..., 0, 2] = -v[..., 2], v[..., 1]
+    S[..., 1, 0], S[..., 1, 2] = v[..., 2], -v[..., 0]
+    S[..., 2, 0], S[..., 2, 1] = -v[..., 1], v[..., 0]
+    return S
+
+
+def perturb_pose(T0: Array, x: Array) -> Array:
+    """``T0`` moved by ``x = (v (m), w (rad))``: ``R = exp([w]) R0``, ``t = t0 + v``."""
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_rotvec(x[3:6]).as_matrix() @ T0[:3, :3]
+    T[:3, 3] = T0[:3, 3] + x[:3]
+    return T
+
+
+def step_state(state: State, x: Array, columns: tuple[str, ...]) -> State:
+    """The state moved by ``x`` over the named columns (the others unchanged)."""
+    full = dict(zip(columns, x, strict=True))
+
+    def block(prefix: str) -> Array:
+        return np.array([full.get(f"{prefix}.{c}", 0.0) for c in POSE_COLUMNS])
+
+    delta = state.delta + np.array([full.get(f"dh.{n}", 0.0) for n in term_names()])
+    return replace(
+        state,
+        T_tool0_camera=perturb_pose(state.T_tool0_camera, block("T_tool0_camera")),
+        T_base_target=perturb_pose(state.T_base_target, block("T_base_target")),
+        T_left_right=(
+            None
+            if state.T_left_right is None
+            else perturb_pose(state.T_left_right, block("T_left_right"))
+        ),
+        delta=delta,
+    )
+
+
+def flange_poses(obs: CalibrationObservations, dh: DHTable | None, delta: Array) -> Array:
+    """``T_base_tool0`` (V, 4, 4) of every view: D-H with errors, or the given flange poses."""
+    if dh is not None and obs.has_joints:
+        return fk_with_errors(dh, delta, obs.joints())
+    return np.array([np.asarray(v.T_base_tool0, float) for v in obs.views])
+
+
+def _project(X: Array, cam: Intrinsics, jac: bool) -> tuple[Array, Array | None]:
+    """Pixels (N, 2) of camera points (N, 3) and d pixel / d X (N, 2, 3)."""
+    px, J = cv2.projectPoints(X.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), cam.K, cam.dist)
+    if not jac:
+        return px.reshape(-1, 2), None
+    return px.reshape(-1, 2), J[:, 3:6].reshape(-1, 2, 3)
+
+
+@dataclass(frozen=True, eq=False)
+class Prediction:
+    """Residuals (predicted - observed, px) of the seen views, and the Jacobian if asked.
+
+    ``residuals`` stacks, per camera (left then right), the seen views' corners (x, y);
+    ``view_index`` (rows/2,) and ``camera`` ("left"/"right" per corner) tell whose they are.
+    """
+
+    residuals: Array
+    jacobian: Array | None
+    view_index: NDArray[np.int64]
+    camera: NDArray[np.str_]
+
+
+def predict(
+    obs: CalibrationObservations, dh: DHTable | None, state: State, jac: bool = True
+) -> Prediction:
+    """Residuals and Jacobian (rows: corners x/y; columns: :func:`column_names`)."""
+    kinematic = dh is not None and obs.has_joints
+    stereo = obs.cameras.stereo and state.T_left_right is not None
+    cols = column_names(stereo, kinematic)
+    p = obs.target.object_points()  # (M, 3)
+    T_bt = flange_poses(obs, dh, state.delta)  # (V, 4, 4)
+    R_bt, t_bt = T_bt[:, :3, :3], T_bt[:, :3, 3]
+    R_X, t_X = state.T_tool0_camera[:3, :3], state.T_tool0_camera[:3, 3]
+    R_Y, t_Y = state.T_base_target[:3, :3], state.T_base_target[:3, 3]
+    Rp = p @ R_Y.T  # (M, 3) rotated corners
+    P_b = Rp + t_Y
+    P_t0 = np.einsum("vji,vmj->vmi", R_bt, P_b[None] - t_bt[:, None])  # R_bt^T (P_b - t_bt)
+    y = P_t0 - t_X
+    X_l = y @ R_X  # R_X^T y, (V, M, 3)
+    V, M = X_l.shape[:2]
+    D = None
+    if jac:
+        D = np.zeros((V, M, 3, len(cols)))
+        A = np.einsum("ji,vkj->vik", R_X, R_bt)  # R_X^T R_bt^T, (V, 3, 3)
+        D[..., 0:3] = -R_X.T
+        D[..., 3:6] = np.einsum("ji,vmjk->vmik", R_X, _skew(y))
+        D[..., 6:9] = A[:, None]
+        D[..., 9:12] = -np.einsum("vij,mjk->vmik", A, _skew(Rp))
+        if kinematic:
+            tw = dh_error_twists(dh, state.delta, obs.joints())  # (V, 24, 6)
+            k0 = 18 if stereo else 12
+            # dX_l = -A (v_s + w_s x P_b)
+            moved = tw[:, None, :, :3] + np.cross(tw[:, None, :, 3:], P_b[None, :, None, :])
+            D[..., k0:] = -np.einsum("vij,vmkj->vmik", A, moved)
+    rows_r, rows_J, views, cams = [], [], [], []
+    sides = [("left", obs.cameras.left)]
+    if stereo:
+        sides.append(("right", obs.cameras.right))
+    for side, cam in sides:
+        corners, seen = obs.corners(side)
+        if not seen.any():
+            continue
+        Xs = X_l[seen]
+        Ds = D[seen] if D is not None else None
+        if side == "right":
+            R_L, t_L = state.T_left_right[:3, :3], state.T_left_right[:3, 3]
+            z = Xs - t_L
+            if Ds is not None:
+                Ds = np.einsum("ji,vmjk->vmik", R_L, Ds)
+                Ds[..., 12:15] = -R_L.T
+                Ds[..., 15:18] = np.einsum("ji,vmjk->vmik", R_L, _skew(z))
+            Xs = z @ R_L
+        px, Jp = _project(Xs.reshape(-1, 3), cam, jac)
+        rows_r.append((px - corners[seen].reshape(-1, 2)).reshape(-1))
+        if Ds is not None:
+            rows_J.append(
+                np.einsum("nij,njk->nik", Jp, Ds.reshape(-1, 3, len(cols))).reshape(-1, len(cols))
+            )
+        views.append(np.repeat(np.flatnonzero(seen), M))
+        cams.append(np.full(int(seen.sum()) * M, side))
+    return Prediction(
+        residuals=np.concatenate(rows_r),
+        jacobian=np.concatenate(rows_J) if jac else None,
+        view_index=np.concatenate(views),
+        camera=np.concatenate(cams),
+    )

@@ -1,0 +1,377 @@
+"""The cell calibration: one least-squares adjustment of all views' reprojection errors.
+
+Observations -> refusals (:mod:`cell.calibration.refusals`) -> starting values from OpenCV
+(:mod:`cell.calibration.initial`) -> identifiability (:mod:`cell.calibration.identifiability`)
+-> ``scipy.optimize.least_squares`` (trust-region reflective, analytic Jacobian from
+:mod:`cell.calibration.model`, columns scaled by their norms, plain squared loss so the
+covariance means what it says) -> :class:`~cell.calibration.result.CellCalibration`.
+
+Covariance of every free unknown: ``s^2 (J^T J)^-1`` with ``J`` the Jacobian at the solution
+and ``s^2 = sum(r^2) / (n - p)`` from the residuals (n corner coordinates, p free unknowns):
+the corner noise is estimated from the data, taken equal in both cameras and independent
+between corners. The intrinsics are taken as exact (from the stereo calibration file); the
+target's geometry as exact (it fixes the scale).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+from datetime import UTC, datetime
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationError
+from cell.calibration.identifiability import IdentifiabilityReport, choose_free
+from cell.calibration.initial import InitialEstimate, initial_estimate
+from cell.calibration.model import State, column_names, flange_poses, predict, step_state
+from cell.calibration.observations import CalibrationObservations
+from cell.calibration.refusals import check_views
+from cell.calibration.result import (
+    CellCalibration,
+    DHTermEstimate,
+    PoseEstimate,
+    Provenance,
+    ViewResidual,
+)
+from robots.calibration import structural_redundancies, term_names
+from robots.dh import DHTable
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class SolveOptions:
+    """Settings of the adjustment.
+
+    Attributes:
+        estimate_kinematics: estimate the D-H error terms (when the views give joints and a
+            nominal table is given).
+        estimate_stereo: estimate the stereo extrinsics (stereo heads); else they are taken
+            from the stereo calibration as exact.
+        max_condition: largest condition number of the column-normalised Jacobian accepted.
+        effect_floor_px: an unknown whose unit change (1 m, 1 rad) moves the corners by less
+            (root sum of squares, px) has no effect.
+        min_views: fewest views accepted (and fewest left images that see the target).
+        min_rotation_rad: smallest relative rotation of a view pair that counts for the axis
+            spread; the largest must reach it.
+        min_axis_spread_rad: smallest spread of the relative rotation axes.
+        max_nfev: limit of residual evaluations of the solver.
+        max_dh_length_m, max_dh_angle_rad: largest plausible D-H length and angle error; a
+            fit beyond says the joints belong to another arm (or another joint zero) than the
+            nominal table, and is refused.
+    """
+
+    estimate_kinematics: bool = True
+    estimate_stereo: bool = True
+    max_condition: float = 1e4
+    effect_floor_px: float = 1.0
+    min_views: int = 3
+    min_rotation_rad: float = math.radians(5.0)
+    min_axis_spread_rad: float = math.radians(5.0)
+    max_nfev: int = 200
+    max_dh_length_m: float = 0.01
+    max_dh_angle_rad: float = math.radians(2.0)
+
+    def __post_init__(self) -> None:
+        if not self.max_condition > 1.0:
+            raise ValueError(f"max_condition must be > 1, got {self.max_condition}")
+        if self.min_views < 3:
+            raise ValueError(f"min_views must be at least 3, got {self.min_views}")
+
+
+@dataclass(frozen=True, eq=False)
+class CalibrationResult:
+    """Outcome of :func:`solve_calibration`: ``status`` "calibrated", the estimates, the rank
+    report, the OpenCV start (every method's hand-eye) and timings (s)."""
+
+    status: str
+    calibration: CellCalibration
+    report: IdentifiabilityReport
+    initial: InitialEstimate | None
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def _left_jacobian(w: Array) -> Array:
+    """Left Jacobian of SO(3) at rotation vector ``w``: ``exp(w + e) = exp(Jl e) exp(w)``."""
+    th = float(np.linalg.norm(w))
+    W = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+    if th < 1e-8:
+        return np.eye(3) + 0.5 * W
+    return np.eye(3) + (1 - np.cos(th)) / th**2 * W + (th - np.sin(th)) / th**3 * W @ W
+
+
+class _Problem:
+    """Residuals and Jacobian over the free columns, relative to a start state."""
+
+    def __init__(
+        self, obs: CalibrationObservations, dh: DHTable | None, start: State, free: tuple[str, ...]
+    ) -> None:
+        self.obs, self.dh, self.start, self.free = obs, dh, start, free
+        stereo = start.T_left_right is not None
+        kinematic = dh is not None and obs.has_joints
+        self.columns = column_names(stereo, kinematic)
+        self.idx = [self.columns.index(c) for c in free]
+        self._x: Array | None = None
+        self._pred = None
+
+    def _at(self, x: Array):
+        if self._x is None or not np.array_equal(x, self._x):
+            self._x, self._pred = (
+                x.copy(),
+                predict(self.obs, self.dh, step_state(self.start, x, self.free)),
+            )
+        return self._pred
+
+    def residuals(self, x: Array) -> Array:
+        return self._at(x).residuals
+
+    def jacobian(self, x: Array) -> Array:
+        J = self._at(x).jacobian[:, self.idx].copy()
+        for prefix in ("T_tool0_camera", "T_base_target", "T_left_right"):
+            names = [f"{prefix}.r{a}_rad" for a in "xyz"]
+            if all(n in self.free for n in names):
+                k = [self.free.index(n) for n in names]
+                J[:, k] = J[:, k] @ _left_jacobian(self._x[k])
+        return J
+
+
+def _fixed_columns(
+    obs: CalibrationObservations,
+    dh: DHTable | None,
+    columns: tuple[str, ...],
+    options: SolveOptions,
+) -> dict[str, str]:
+    fixed: dict[str, str] = {}
+    if dh is not None and obs.has_joints:
+        if options.estimate_kinematics:
+            fixed = {f"dh.{k}": v for k, v in structural_redundancies(dh).items()}
+        else:
+            fixed = {f"dh.{n}": "kinematic terms not estimated (options)" for n in term_names()}
+    if not options.estimate_stereo:
+        fixed.update(
+            {
+                c: "stereo extrinsics taken from the stereo calibration"
+                for c in columns
+                if c.startswith("T_left_right.")
+            }
+        )
+    return fixed
+
+
+def solve_calibration(
+    obs: CalibrationObservations,
+    dh: DHTable | None = None,
+    options: SolveOptions | None = None,
+    provenance: Provenance | None = None,
+    start: State | None = None,
+) -> CalibrationResult:
+    """Estimate hand-eye, target pose, stereo extrinsics and D-H errors from ``obs``.
+
+    ``dh``: the nominal table (required for views with joints; the D-H terms are estimated
+    then). ``start``: starting values instead of OpenCV's (D-H errors start at ``start.delta``).
+    Raises :class:`DegenerateCalibrationError` for a data set that cannot determine the
+    hand-eye, :class:`CalibrationDataError` for unusable observations.
+    """
+    opts = options or SolveOptions()
+    t0 = time.perf_counter()
+    if obs.has_joints and dh is None:
+        raise DegenerateCalibrationError("the views give joints but no nominal D-H table was given")
+    T_bt = flange_poses(obs, dh, np.zeros(24))
+    check_views(obs, T_bt, opts.min_views, opts.min_rotation_rad, opts.min_axis_spread_rad)
+    init = None
+    if start is None:
+        init = initial_estimate(obs, T_bt)
+        L = obs.cameras.T_left_right if obs.cameras.stereo else None
+        start = State(init.best.T_tool0_camera, init.best.T_base_target, L, np.zeros(24))
+    t_init = time.perf_counter()
+    stereo = start.T_left_right is not None
+    kinematic = dh is not None and obs.has_joints
+    columns = column_names(stereo, kinematic)
+    # a first fit of the poses alone puts the rank test at a good linearisation point
+    poses = tuple(c for c in columns if not c.startswith("dh."))
+    if not opts.estimate_stereo:
+        poses = tuple(c for c in poses if not c.startswith("T_left_right."))
+    start = _fit(obs, dh, start, poses, opts)
+    J = predict(obs, dh, start).jacobian
+    report = choose_free(
+        J, columns, _fixed_columns(obs, dh, columns, opts), opts.max_condition, opts.effect_floor_px
+    )
+    t_rank = time.perf_counter()
+    state = _fit(obs, dh, start, report.free, opts)
+    _check_plausible(obs, state, report.free, opts)
+    pred = predict(obs, dh, state)  # at the solution: the perturbation there is exact
+    Jf = pred.jacobian[:, [columns.index(c) for c in report.free]]
+    n, p = len(pred.residuals), len(report.free)
+    if n <= p:
+        raise DegenerateCalibrationError(f"{n} corner coordinates for {p} unknowns")
+    s2 = float(pred.residuals @ pred.residuals) / (n - p)
+    _u, sv, vt = np.linalg.svd(Jf, full_matrices=False)
+    cov = s2 * (vt.T / sv**2) @ vt
+    t_end = time.perf_counter()
+    cal = _calibration(obs, dh, state, report, cov, s2, pred, provenance or Provenance(), init)
+    return CalibrationResult(
+        status="calibrated",
+        calibration=cal,
+        report=report,
+        initial=init,
+        timings={
+            "initial_s": t_init - t0,
+            "rank_s": t_rank - t_init,
+            "solve_s": t_end - t_rank,
+            "total_s": t_end - t0,
+        },
+    )
+
+
+def _check_plausible(
+    obs: CalibrationObservations, state: State, free: tuple[str, ...], opts: SolveOptions
+) -> None:
+    """Refuse D-H errors no arm of the nominal model has (another arm's joints, say)."""
+    for k, name in enumerate(term_names()):
+        if f"dh.{name}" not in free:
+            continue
+        value = float(state.delta[k])
+        length = name.endswith("_m")
+        limit = opts.max_dh_length_m if length else opts.max_dh_angle_rad
+        if abs(value) > limit:
+            shown = f"{value * 1e3:.2f} mm" if length else f"{math.degrees(value):.3f} deg"
+            bound = f"{limit * 1e3:g} mm" if length else f"{math.degrees(limit):g} deg"
+            raise CalibrationDataError(
+                obs.source,
+                f"the fit needs a D-H error {name} = {shown} (plausible: within {bound}): "
+                "do the joints come from the arm of the nominal table (the cell's robot model)?",
+            )
+
+
+def _fit(
+    obs: CalibrationObservations,
+    dh: DHTable | None,
+    start: State,
+    free: tuple[str, ...],
+    opts: SolveOptions,
+) -> State:
+    prob = _Problem(obs, dh, start, free)
+    sol = least_squares(
+        prob.residuals,
+        np.zeros(len(free)),
+        jac=prob.jacobian,
+        method="trf",
+        x_scale="jac",
+        xtol=1e-12,
+        ftol=1e-12,
+        gtol=1e-10,
+        max_nfev=opts.max_nfev,
+    )
+    return step_state(start, sol.x, free)
+
+
+def _pose_block(cov: Array, free: tuple[str, ...], prefix: str) -> Array:
+    from cell.calibration.model import POSE_COLUMNS
+
+    names = [f"{prefix}.{c}" for c in POSE_COLUMNS]
+    out = np.zeros((6, 6))
+    for i, a in enumerate(names):
+        for j, b in enumerate(names):
+            if a in free and b in free:
+                out[i, j] = cov[free.index(a), free.index(b)]
+    return out
+
+
+def _calibration(obs, dh, state, report, cov, s2, pred, prov, init) -> CellCalibration:
+    free = report.free
+    terms: tuple[DHTermEstimate, ...] = ()
+    if dh is not None and obs.has_joints:
+        terms = tuple(
+            DHTermEstimate(
+                name=n,
+                value=float(state.delta[k]),
+                sigma=float(np.sqrt(cov[free.index(f"dh.{n}")][free.index(f"dh.{n}")]))
+                if f"dh.{n}" in free
+                else 0.0,
+                free=f"dh.{n}" in free,
+                reason=report.fixed.get(f"dh.{n}", ""),
+            )
+            for k, n in enumerate(term_names())
+        )
+    M = len(obs.target.object_points())
+    r2 = pred.residuals.reshape(-1, 2)
+    views = []
+    for i, v in enumerate(obs.views):
+        rms = {}
+        for side in ("left", "right"):
+            sel = (pred.view_index == i) & (pred.camera == side)
+            rms[side] = (
+                float(np.sqrt(np.mean(np.sum(r2[sel] ** 2, axis=1)))) if sel.any() else float("nan")
+            )
+        views.append(
+            ViewResidual(v.name, rms["left"], rms["right"], int((pred.view_index == i).sum()))
+        )
+    per_cam = {}
+    for side in ("left", "right"):
+        sel = pred.camera == side
+        if sel.any():
+            per_cam[side] = float(np.sqrt(np.mean(np.sum(r2[sel] ** 2, axis=1))))
+    notes = []
+    if init is not None:
+        notes.append(
+            f"start: OpenCV hand-eye method {init.best.method} "
+            f"(the most consistent of {len(init.candidates)})"
+        )
+    notes.append(
+        "covariance: s^2 (J^T J)^-1, s^2 from the residuals; "
+        "intrinsics and target geometry taken as exact"
+    )
+    med = np.nanmedian([v.rms_left_px for v in views])
+    for v in views:
+        if v.rms_left_px > 3 * med and v.rms_left_px > 0.5:
+            notes.append(
+                f"warning: view {v.name} fits {v.rms_left_px:.2f} px, "
+                f"more than 3x the median {med:.2f} px"
+            )
+    n, p = len(pred.residuals), len(free)
+    return CellCalibration(
+        T_tool0_camera=PoseEstimate(state.T_tool0_camera, _pose_block(cov, free, "T_tool0_camera")),
+        T_base_target=PoseEstimate(state.T_base_target, _pose_block(cov, free, "T_base_target")),
+        T_left_right=None
+        if state.T_left_right is None
+        else PoseEstimate(state.T_left_right, _pose_block(cov, free, "T_left_right")),
+        nominal_dh=dh if terms else None,
+        dh_terms=terms,
+        parameter_names=free,
+        covariance=cov,
+        sigma_px=float(np.sqrt(s2)),
+        residual_rms_px=per_cam,
+        views=tuple(views),
+        counts={
+            "views": len(obs.views),
+            "points": n // 2,
+            "residuals": n,
+            "parameters": p,
+            "dof": n - p,
+            "corners_per_view": M,
+        },
+        target={
+            "kind": obs.target.kind,
+            "cols": obs.target.cols,
+            "rows": obs.target.rows,
+            "pitch_m": obs.target.pitch_m,
+        },
+        provenance=prov,
+        created_utc=datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        notes=tuple(notes),
+    )
+
+
+def pose_error(T_est: Array, T_true: Array) -> tuple[float, float]:
+    """``(position error (m), rotation angle (rad))`` between two poses."""
+    dp = float(np.linalg.norm(T_est[:3, 3] - T_true[:3, 3]))
+    da = float(Rotation.from_matrix(T_est[:3, :3] @ T_true[:3, :3].T).magnitude())
+    return dp, da
+
+
+__all__ = ["CalibrationResult", "SolveOptions", "pose_error", "replace", "solve_calibration"]

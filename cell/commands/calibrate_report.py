@@ -1,0 +1,68 @@
+"""Terminal report of a cell calibration (``holecell calibrate hand-eye``, ``calibrate cell``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cell.calibration.result import PoseEstimate
+from cell.calibration.solve import CalibrationResult, pose_error
+
+
+def _pose_line(name: str, p: PoseEstimate) -> str:
+    from scipy.spatial.transform import Rotation
+
+    xyz = p.T[:3, 3] * 1e3
+    s = p.sigma_xyz_m * 1e3
+    rpy = np.rad2deg(Rotation.from_matrix(p.T[:3, :3]).as_euler("xyz"))
+    sr = np.rad2deg(p.sigma_rot_rad)
+    pos = ", ".join(f"{v:.3f} ± {e:.3f}" for v, e in zip(xyz, s, strict=True))
+    rot = ", ".join(f"{v:.4f}" for v in rpy)
+    srot = ", ".join(f"{e:.4f}" for e in sr)
+    return f"{name}: xyz [{pos}] mm, rpy [{rot}] deg (rotation sigma [{srot}] deg)"
+
+
+def print_result(result: CalibrationResult) -> None:
+    """Print the estimates with their sigmas, the fixed terms, residuals and OpenCV's answers."""
+    cal = result.calibration
+    c = cal.counts
+    print(
+        f"{c['views']} views, {c['points']} corners, {c['parameters']} unknowns, "
+        f"corner noise s = {cal.sigma_px:.3f} px (from the residuals)"
+    )
+    width = max(len(v.name) for v in cal.views)
+    for v in cal.views:
+        right = "" if np.isnan(v.rms_right_px) else f"  right {v.rms_right_px:.3f} px"
+        print(f"  {v.name:<{width}}  left {v.rms_left_px:.3f} px{right}")
+    rms = ", ".join(f"{k} {v:.3f} px" for k, v in cal.residual_rms_px.items())
+    print(f"reprojection RMS: {rms}")
+    print(_pose_line("T_tool0_camera", cal.T_tool0_camera))
+    print(_pose_line("T_base_target", cal.T_base_target))
+    if cal.T_left_right is not None:
+        print(_pose_line("T_left_right", cal.T_left_right))
+    free = [t for t in cal.dh_terms if t.free]
+    if free:
+        terms = ", ".join(
+            f"{t.name} {t.value * (1e3 if t.name.endswith('_m') else np.rad2deg(1)):+.4f}"
+            f"±{t.sigma * (1e3 if t.name.endswith('_m') else np.rad2deg(1)):.4f}"
+            for t in free
+        )
+        print(f"D-H errors (mm, deg): {terms}")
+    for name, reason in result.report.fixed.items():
+        print(f"  fixed {name}: {reason}")
+    print(
+        f"condition number {result.report.condition_free:.3g} (column-normalised), "
+        f"solve {result.timings['total_s']:.2f} s"
+    )
+    if result.initial is not None:
+        for cand in result.initial.candidates:
+            if not np.isfinite(cand.spread_m):
+                print(f"  OpenCV {cand.method}: failed")
+                continue
+            dp, da = pose_error(cand.T_tool0_camera, cal.T_tool0_camera.T)
+            print(
+                f"  OpenCV {cand.method}: hand-eye differs by {dp * 1e3:.3f} mm, "
+                f"{np.rad2deg(da):.4f} deg (target spread {cand.spread_m * 1e3:.3f} mm)"
+            )
+    for note in cal.notes:
+        if note.startswith("warning"):
+            print(note)
