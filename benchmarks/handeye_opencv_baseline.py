@@ -265,3 +265,44 @@ def joint_refinement(
         fun, np.concatenate([_pose_params(X0), _pose_params(T_base_board0)]), method="lm"
     )
     return _params_pose(sol.x[:6]), _params_pose(sol.x[6:])
+
+
+def subset(v: Views, keep: list[int]) -> Views:
+    """The views at ``keep``."""
+    pick = lambda xs: [xs[i] for i in keep]  # noqa: E731
+    return Views(
+        pick(v.names),
+        pick(v.obj),
+        pick(v.img),
+        pick(v.T_base_tool0),
+        v.dropped,
+        v.flipped,
+        v.size_wh,
+    )
+
+
+def jackknife(v: Views, T_cam_board: list[np.ndarray], K, dist) -> dict[str, np.ndarray]:
+    """Leave-one-view-out standard deviations of PARK's and the reprojection answer's
+    ``T_tool0_camera``: ``[σx, σy, σz]`` (mm) and ``[σ about x, y, z]`` (deg, of the rotation
+    vector of each estimate relative to their mean), from ``(n-1)/n Σ (θ_i - θ̄)²``."""
+    est: dict[str, list[np.ndarray]] = {"PARK": [], "reproj-LM": []}
+    n = len(v.names)
+    for i in range(n):
+        keep = [j for j in range(n) if j != i]
+        w, T = subset(v, keep), [T_cam_board[j] for j in keep]
+        X0 = opencv_answers(w, T)["PARK"]["X"]
+        est["PARK"].append(X0)
+        est["reproj-LM"].append(joint_refinement(w, X0, board_in_base(w, X0, T), K, dist)[0])
+    out = {}
+    for name, Xs in est.items():
+        R_mean = Rotation.from_matrix(np.array([X[:3, :3] for X in Xs])).mean()
+        rv = np.array([(R_mean.inv() * Rotation.from_matrix(X[:3, :3])).as_rotvec() for X in Xs])
+        t = np.array([X[:3, 3] for X in Xs]) * 1e3
+        f = (n - 1) / n
+        out[name] = np.concatenate(
+            [
+                np.sqrt(f * ((t - t.mean(0)) ** 2).sum(0)),
+                np.degrees(np.sqrt(f * ((rv - rv.mean(0)) ** 2).sum(0))),
+            ]
+        )
+    return out

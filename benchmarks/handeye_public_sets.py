@@ -124,7 +124,7 @@ def read_holecell(path: str) -> np.ndarray:
     return pose_matrix(Rotation.from_quat(pose["quat_xyzw"]).as_matrix(), pose["xyz"])
 
 
-def compare(out: Path, holecell: list[str]) -> int:
+def compare(out: Path, holecell: list[str], jackknife: bool = False) -> int:
     """Print the comparison table for a converted set."""
     meta = json.loads((out / "set.json").read_text())
     board = Board(**meta["board"])
@@ -187,6 +187,13 @@ def compare(out: Path, holecell: list[str]) -> int:
     if a := answers.get("published"):
         rms, _ = cvb.reprojection_rms(views, a["X"], a["base_board"], K, dist, refit=False)
         print(f"published with its own T_base_board (no refit): {rms:.3f} px")
+    if jackknife:
+        for name, s in cvb.jackknife(views, T_cb, K, dist).items():
+            print(
+                f"leave-one-view-out sigma {name:<10} xyz {np.round(s[:3], 3).tolist()} mm, "
+                f"rotation {np.round(s[3:], 4).tolist()} deg"
+            )
+            rows[name]["jackknife_sigma_mm_deg"] = s.tolist()
     (out / "compare.json").write_text(json.dumps(rows, indent=1))
     return 0
 
@@ -201,11 +208,14 @@ def main(argv: list[str] | None = None) -> int:
     m = sub.add_parser("compare", help="OpenCV methods (and holecell's answer) on a converted set")
     m.add_argument("out", type=Path)
     m.add_argument("--holecell", nargs="*", default=[], help="holecell output file(s)")
+    m.add_argument(
+        "--jackknife", action="store_true", help="leave-one-view-out sigmas (PARK, reproj-LM)"
+    )
     args = ap.parse_args(argv)
     try:
         if args.cmd == "convert":
             return convert(args.kind, args.folder, args.out)
-        return compare(args.out, args.holecell)
+        return compare(args.out, args.holecell, args.jackknife)
     except DataSetError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
