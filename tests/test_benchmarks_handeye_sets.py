@@ -98,3 +98,44 @@ def test_kuka_row_major_matrix_in_metres_is_read_and_millimetres_refused(tmp_pat
     assert "RobotPosesVec.txt row 1: not a 4 x 4 pose in metres" in res.stderr
     assert "Traceback" not in res.stderr
     assert not (tmp_path / "o2").exists()
+
+
+def _board_image(cols: int, rows: int, side_px: int = 40, margin_px: int = 60) -> np.ndarray:
+    """A chessboard of (cols + 1) x (rows + 1) squares, dark square at the top-left."""
+    h, w = (rows + 1) * side_px + 2 * margin_px, (cols + 1) * side_px + 2 * margin_px
+    img = np.full((h, w), 255, np.uint8)
+    for i in range(rows + 1):
+        for j in range(cols + 1):
+            if (i + j) % 2 == 0:
+                y, x = margin_px + i * side_px, margin_px + j * side_px
+                img[y : y + side_px, x : x + side_px] = 30
+    return img
+
+
+def test_corner_order_is_the_same_physical_order_after_a_half_turn() -> None:
+    sys.path.insert(0, str(SCRIPT.parent))
+    try:
+        import handeye_opencv_baseline as cvb
+        from handeye_sets_io import Board
+    finally:
+        sys.path.pop(0)
+    board = Board("chessboard", 9, 6, 0.02)
+    img = _board_image(9, 6)
+    turned = np.ascontiguousarray(img[::-1, ::-1])
+    a, _ = cvb.detect_chessboard(img, board)
+    b, _ = cvb.detect_chessboard(turned, board)
+    assert a is not None and b is not None
+    a, b = a.reshape(-1, 2), b.reshape(-1, 2)
+    h, w = img.shape
+    b_in_img = np.stack([w - 1 - b[:, 0], h - 1 - b[:, 1]], axis=1)
+    np.testing.assert_allclose(b_in_img, a, atol=0.5)
+    # the dark square diagonally beyond corner 0 is the board's dark top-left square
+    assert np.linalg.norm(a[0] - [60 + 40, 60 + 40]) < 1.5
+    # and corners handed over in the other order are put back, with the reversal reported
+    pts = a.reshape(-1, 1, 2).astype(np.float32)
+    back, reversed_ = cvb._canonical_order(img, pts[::-1].copy(), board)
+    assert reversed_
+    np.testing.assert_array_equal(back, pts)
+    same, reversed_ = cvb._canonical_order(img, pts, board)
+    assert not reversed_
+    np.testing.assert_array_equal(same, pts)
