@@ -210,8 +210,10 @@ def solve_calibration(
     if n <= p:
         raise DegenerateCalibrationError(f"{n} corner coordinates for {p} unknowns")
     s2 = float(pred.residuals @ pred.residuals) / (n - p)
-    _u, sv, vt = np.linalg.svd(Jf, full_matrices=False)
-    cov = s2 * (vt.T / sv**2) @ vt
+    norms = np.linalg.norm(Jf, axis=0)  # columns scaled to one before inverting (m vs rad)
+    Jn = Jf / norms
+    cov = s2 * np.linalg.inv(Jn.T @ Jn) / np.outer(norms, norms)  # full rank: checked above
+    cov = 0.5 * (cov + cov.T)
     t_end = time.perf_counter()
     cal = _calibration(obs, dh, state, report, cov, s2, pred, provenance or Provenance(), init)
     return CalibrationResult(
@@ -260,7 +262,7 @@ def _fit(
         prob.residuals,
         np.zeros(len(free)),
         jac=prob.jacobian,
-        method="trf",
+        method="lm",
         x_scale="jac",
         xtol=1e-12,
         ftol=1e-12,

@@ -241,3 +241,41 @@ def reference_joints(truth: SyntheticTruth, standoff_m: float = 0.25) -> Array:
     if not ik.ok:
         raise ValueError(f"the straight view is out of reach: {ik.reason}")
     return ik.solutions[np.argmin(np.linalg.norm(ik.solutions, axis=1))]
+
+
+def truth_in_gauge(truth: SyntheticTruth) -> State:
+    """The truth as the calibration can see it: the structurally redundant D-H terms folded
+    into the target's and the camera's poses (``robots.calibration.redundancy.fold_redundant``)."""
+    from robots.calibration.redundancy import fold_redundant
+
+    delta, C, E = fold_redundant(truth.dh, truth.truth.delta)
+    return State(
+        T_tool0_camera=E @ truth.truth.T_tool0_camera,
+        T_base_target=np.linalg.inv(C) @ truth.truth.T_base_target,
+        T_left_right=truth.truth.T_left_right,
+        delta=delta,
+    )
+
+
+def parameter_errors(cal, truth: State) -> dict[str, float]:
+    """Estimate minus truth of every free parameter of a calibration (m, rad), in the
+    calibration's perturbation (position difference; rotation vector of ``R_est R_true^T``)."""
+    from robots.calibration import term_names
+
+    out: dict[str, float] = {}
+    poses = {
+        "T_tool0_camera": (cal.T_tool0_camera.T, truth.T_tool0_camera),
+        "T_base_target": (cal.T_base_target.T, truth.T_base_target),
+    }
+    if cal.T_left_right is not None and truth.T_left_right is not None:
+        poses["T_left_right"] = (cal.T_left_right.T, truth.T_left_right)
+    for prefix, (est, true) in poses.items():
+        dv = est[:3, 3] - true[:3, 3]
+        dw = Rotation.from_matrix(est[:3, :3] @ true[:3, :3].T).as_rotvec()
+        for c, v in zip(
+            ("x_m", "y_m", "z_m", "rx_rad", "ry_rad", "rz_rad"), (*dv, *dw), strict=True
+        ):
+            out[f"{prefix}.{c}"] = float(v)
+    for k, n in enumerate(term_names()):
+        out[f"dh.{n}"] = float(cal.delta[k] - truth.delta[k])
+    return {n: out[n] for n in cal.parameter_names}
