@@ -112,18 +112,27 @@ class Prediction:
 
     ``residuals`` stacks, per camera (left then right), the seen views' corners (x, y);
     ``view_index`` (rows/2,) and ``camera`` ("left"/"right" per corner) tell whose they are.
+    ``flange_jacobian`` (rows, 6), when asked: d residual / d (flange position error (m),
+    flange rotation error about the flange's origin (rad)), both in ``base_link``, of the
+    row's own view (an error of the arm's pose at that view alone).
     """
 
     residuals: Array
     jacobian: Array | None
     view_index: NDArray[np.int64]
     camera: NDArray[np.str_]
+    flange_jacobian: Array | None = None
 
 
 def predict(
-    obs: CalibrationObservations, dh: DHTable | None, state: State, jac: bool = True
+    obs: CalibrationObservations,
+    dh: DHTable | None,
+    state: State,
+    jac: bool = True,
+    flange_jac: bool = False,
 ) -> Prediction:
-    """Residuals and Jacobian (rows: corners x/y; columns: :func:`column_names`)."""
+    """Residuals and Jacobian (rows: corners x/y; columns: :func:`column_names`); with
+    ``flange_jac`` also the Jacobian of each row against its view's flange pose error."""
     kinematic = dh is not None and obs.has_joints
     stereo = obs.cameras.stereo and state.T_left_right is not None
     cols = column_names(stereo, kinematic)
@@ -139,8 +148,9 @@ def predict(
     X_l = y @ R_X  # R_X^T y, (V, M, 3)
     V, M = X_l.shape[:2]
     D = None
-    if jac:
-        D = np.zeros((V, M, 3, len(cols)))
+    n_cols = len(cols) + (6 if flange_jac else 0)
+    if jac or flange_jac:
+        D = np.zeros((V, M, 3, n_cols))
         A = np.einsum("ji,vkj->vik", R_X, R_bt)  # R_X^T R_bt^T, (V, 3, 3)
         D[..., 0:3] = -R_X.T
         D[..., 3:6] = np.einsum("ji,vmjk->vmik", R_X, _skew(y))
@@ -151,7 +161,11 @@ def predict(
             k0 = 18 if stereo else 12
             # dX_l = -A (v_s + w_s x P_b)
             moved = tw[:, None, :, :3] + np.cross(tw[:, None, :, 3:], P_b[None, :, None, :])
-            D[..., k0:] = -np.einsum("vij,vmkj->vmik", A, moved)
+            D[..., k0 : k0 + 24] = -np.einsum("vij,vmkj->vmik", A, moved)
+        if flange_jac:  # dX_l = -A (dp + dtheta x (P_b - p_flange))
+            arm = P_b[None] - t_bt[:, None]  # (V, M, 3)
+            D[..., -6:-3] = -A[:, None]
+            D[..., -3:] = np.einsum("vij,vmjk->vmik", A, _skew(arm))
     rows_r, rows_J, views, cams = [], [], [], []
     sides = [("left", obs.cameras.left)]
     if stereo:
@@ -170,17 +184,19 @@ def predict(
                 Ds[..., 12:15] = -R_L.T
                 Ds[..., 15:18] = np.einsum("ji,vmjk->vmik", R_L, _skew(z))
             Xs = z @ R_L
-        px, Jp = _project(Xs.reshape(-1, 3), cam, jac)
+        px, Jp = _project(Xs.reshape(-1, 3), cam, Ds is not None)
         rows_r.append((px - corners[seen].reshape(-1, 2)).reshape(-1))
         if Ds is not None:
             rows_J.append(
-                np.einsum("nij,njk->nik", Jp, Ds.reshape(-1, 3, len(cols))).reshape(-1, len(cols))
+                np.einsum("nij,njk->nik", Jp, Ds.reshape(-1, 3, n_cols)).reshape(-1, n_cols)
             )
         views.append(np.repeat(np.flatnonzero(seen), M))
         cams.append(np.full(int(seen.sum()) * M, side))
+    J_all = np.concatenate(rows_J) if rows_J else None
     return Prediction(
         residuals=np.concatenate(rows_r),
-        jacobian=np.concatenate(rows_J) if jac else None,
+        jacobian=J_all[:, : len(cols)] if jac else None,
         view_index=np.concatenate(views),
         camera=np.concatenate(cams),
+        flange_jacobian=J_all[:, len(cols) :] if flange_jac else None,
     )

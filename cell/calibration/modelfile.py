@@ -96,6 +96,7 @@ def calibration_to_dict(cal: CellCalibration) -> dict[str, Any]:
         "parameters": {"names": list(cal.parameter_names), "covariance": cal.covariance.tolist()},
         "residuals": {
             "sigma_px": cal.sigma_px,
+            "flange_scatter": dict(cal.flange_scatter),
             "rms_px": dict(cal.residual_rms_px),
             "views": [
                 {
@@ -303,7 +304,20 @@ def calibration_from_dict(data: Any, path: str = "<memory>") -> CellCalibration:
         provenance=prov,
         created_utc=created,
         notes=tuple(str(n) for n in notes),
+        flange_scatter=_flange_scatter(r, res),
     )
+
+
+def _flange_scatter(r: _Reader, res: dict) -> dict[str, object]:
+    """``residuals.flange_scatter``: optional (files before it hold corner noise only)."""
+    if "flange_scatter" not in res:
+        return {}
+    fs = r.get(res, "flange_scatter", "residuals.flange_scatter", dict)
+    return {
+        "sigma_m": r.number(fs, "sigma_m", "residuals.flange_scatter.sigma_m"),
+        "sigma_rad": r.number(fs, "sigma_rad", "residuals.flange_scatter.sigma_rad"),
+        "source": r.get(fs, "source", "residuals.flange_scatter.source", str),
+    }
 
 
 def load_calibration(path: str | Path) -> CellCalibration:

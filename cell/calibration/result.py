@@ -86,9 +86,11 @@ class CellCalibration:
         T_left_right: the right camera in the left one (stereo heads; ``None`` for mono).
         nominal_dh: the nominal table the D-H errors add to (``None``: no kinematic terms).
         dh_terms: all 24 D-H error terms (free and fixed with reasons); empty without kinematics.
-        parameter_names, covariance: the joint covariance of the free parameters,
-            ``s^2 (J^T J)^-1`` with ``s^2`` the residuals' sum of squares over ``dof``.
+        parameter_names, covariance: the joint covariance of the free parameters (corner
+            noise and the flange scatter, :mod:`cell.calibration.covariance`).
         sigma_px: ``s``, the estimated corner noise (px).
+        flange_scatter: ``sigma_m``, ``sigma_rad`` (per axis) and ``source`` of the per-view
+            flange pose error the covariance holds (:mod:`cell.calibration.covariance`).
         residual_rms_px: per camera ("left", "right").
         views: per-view residuals.
         counts: ``views``, ``points`` (corners), ``residuals``, ``parameters``, ``dof``.
@@ -111,6 +113,7 @@ class CellCalibration:
     provenance: Provenance = field(default_factory=Provenance)
     created_utc: str = ""
     notes: tuple[str, ...] = ()
+    flange_scatter: dict[str, object] = field(default_factory=dict)
 
     @property
     def delta(self) -> Array:

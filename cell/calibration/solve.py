@@ -6,10 +6,12 @@ Observations -> refusals (:mod:`cell.calibration.refusals`) -> starting values f
 :mod:`cell.calibration.model`, columns scaled by their norms, plain squared loss so the
 covariance means what it says) -> :class:`~cell.calibration.result.CellCalibration`.
 
-Covariance of every free unknown: ``s^2 (J^T J)^-1`` with ``J`` the Jacobian at the solution
-and ``s^2 = sum(r^2) / (n - p)`` from the residuals (n corner coordinates, p free unknowns):
-the corner noise is estimated from the data, taken equal in both cameras and independent
-between corners. The intrinsics are taken as exact (from the stereo calibration file); the
+Covariance of every free unknown (:mod:`cell.calibration.covariance`): the corner noise
+``s^2`` from the residuals, taken equal in both cameras and independent between corners, plus
+(by default) an independent error of each view's flange pose (the arm's repeatability and
+what the kinematic model leaves out), estimated from the per-view residuals or given: the
+sandwich ``(J^T J)^-1 J^T Omega J (J^T J)^-1`` at the solution. With ``flange_scatter=False``,
+``s^2 (J^T J)^-1``. The intrinsics are taken as exact (from the stereo calibration file); the
 target's geometry as exact (it fixes the scale).
 """
 
@@ -17,14 +19,15 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
-from datetime import UTC, datetime
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from cell.calibration.assemble import build_calibration
+from cell.calibration.covariance import flange_scatter_covariance, white_covariance
 from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationError
 from cell.calibration.identifiability import IdentifiabilityReport, choose_free
 from cell.calibration.initial import InitialEstimate, initial_estimate
@@ -33,10 +36,7 @@ from cell.calibration.observations import CalibrationObservations
 from cell.calibration.refusals import check_views
 from cell.calibration.result import (
     CellCalibration,
-    DHTermEstimate,
-    PoseEstimate,
     Provenance,
-    ViewResidual,
 )
 from robots.calibration import structural_redundancies, term_names
 from robots.dh import DHTable
@@ -61,6 +61,10 @@ class SolveOptions:
             spread; the largest must reach it.
         min_axis_spread_rad: smallest spread of the relative rotation axes.
         max_nfev: limit of residual evaluations of the solver.
+        flange_scatter: model an independent error of each view's flange pose in the
+            covariance (:mod:`cell.calibration.covariance`); False: corner noise only.
+        flange_sigma_m, flange_sigma_rad: that error per axis (m, rad), e.g. from the arm's
+            repeatability; ``None``: estimated from the per-view residuals.
         max_dh_length_m, max_dh_angle_rad: largest plausible D-H length and angle error; a
             fit beyond says the joints belong to another arm (or another joint zero) than the
             nominal table, and is refused.
@@ -76,6 +80,9 @@ class SolveOptions:
     max_nfev: int = 200
     max_dh_length_m: float = 0.01
     max_dh_angle_rad: float = math.radians(2.0)
+    flange_scatter: bool = True
+    flange_sigma_m: float | None = None
+    flange_sigma_rad: float | None = None
 
     def __post_init__(self) -> None:
         if not self.max_condition > 1.0:
@@ -204,18 +211,26 @@ def solve_calibration(
     t_rank = time.perf_counter()
     state = _fit(obs, dh, start, report.free, opts)
     _check_plausible(obs, state, report.free, opts)
-    pred = predict(obs, dh, state)  # at the solution: the perturbation there is exact
+    pred = predict(obs, dh, state, flange_jac=True)  # at the solution: the perturbation is exact
     Jf = pred.jacobian[:, [columns.index(c) for c in report.free]]
     n, p = len(pred.residuals), len(report.free)
     if n <= p:
         raise DegenerateCalibrationError(f"{n} corner coordinates for {p} unknowns")
-    s2 = float(pred.residuals @ pred.residuals) / (n - p)
-    norms = np.linalg.norm(Jf, axis=0)  # columns scaled to one before inverting (m vs rad)
-    Jn = Jf / norms
-    cov = s2 * np.linalg.inv(Jn.T @ Jn) / np.outer(norms, norms)  # full rank: checked above
-    cov = 0.5 * (cov + cov.T)
+    if opts.flange_scatter:
+        n_stereo = sum(c.startswith("T_left_right.") for c in report.free)
+        cr = flange_scatter_covariance(
+            Jf,
+            pred.residuals,
+            pred.flange_jacobian,
+            np.repeat(pred.view_index, 2),
+            n_stereo,
+            opts.flange_sigma_m,
+            opts.flange_sigma_rad,
+        )
+    else:
+        cr = white_covariance(Jf, pred.residuals)
     t_end = time.perf_counter()
-    cal = _calibration(obs, dh, state, report, cov, s2, pred, provenance or Provenance(), init)
+    cal = build_calibration(obs, dh, state, report, cr, pred, provenance or Provenance(), init)
     return CalibrationResult(
         status="calibrated",
         calibration=cal,
@@ -272,103 +287,6 @@ def _fit(
     return step_state(start, sol.x, free)
 
 
-def _pose_block(cov: Array, free: tuple[str, ...], prefix: str) -> Array:
-    from cell.calibration.model import POSE_COLUMNS
-
-    names = [f"{prefix}.{c}" for c in POSE_COLUMNS]
-    out = np.zeros((6, 6))
-    for i, a in enumerate(names):
-        for j, b in enumerate(names):
-            if a in free and b in free:
-                out[i, j] = cov[free.index(a), free.index(b)]
-    return out
-
-
-def _calibration(obs, dh, state, report, cov, s2, pred, prov, init) -> CellCalibration:
-    free = report.free
-    terms: tuple[DHTermEstimate, ...] = ()
-    if dh is not None and obs.has_joints:
-        terms = tuple(
-            DHTermEstimate(
-                name=n,
-                value=float(state.delta[k]),
-                sigma=float(np.sqrt(cov[free.index(f"dh.{n}")][free.index(f"dh.{n}")]))
-                if f"dh.{n}" in free
-                else 0.0,
-                free=f"dh.{n}" in free,
-                reason=report.fixed.get(f"dh.{n}", ""),
-            )
-            for k, n in enumerate(term_names())
-        )
-    M = len(obs.target.object_points())
-    r2 = pred.residuals.reshape(-1, 2)
-    views = []
-    for i, v in enumerate(obs.views):
-        rms = {}
-        for side in ("left", "right"):
-            sel = (pred.view_index == i) & (pred.camera == side)
-            rms[side] = (
-                float(np.sqrt(np.mean(np.sum(r2[sel] ** 2, axis=1)))) if sel.any() else float("nan")
-            )
-        views.append(
-            ViewResidual(v.name, rms["left"], rms["right"], int((pred.view_index == i).sum()))
-        )
-    per_cam = {}
-    for side in ("left", "right"):
-        sel = pred.camera == side
-        if sel.any():
-            per_cam[side] = float(np.sqrt(np.mean(np.sum(r2[sel] ** 2, axis=1))))
-    notes = []
-    if init is not None:
-        notes.append(
-            f"start: OpenCV hand-eye method {init.best.method} "
-            f"(the most consistent of {len(init.candidates)})"
-        )
-    notes.append(
-        "covariance: s^2 (J^T J)^-1, s^2 from the residuals; "
-        "intrinsics and target geometry taken as exact"
-    )
-    med = np.nanmedian([v.rms_left_px for v in views])
-    for v in views:
-        if v.rms_left_px > 3 * med and v.rms_left_px > 0.5:
-            notes.append(
-                f"warning: view {v.name} fits {v.rms_left_px:.2f} px, "
-                f"more than 3x the median {med:.2f} px"
-            )
-    n, p = len(pred.residuals), len(free)
-    return CellCalibration(
-        T_tool0_camera=PoseEstimate(state.T_tool0_camera, _pose_block(cov, free, "T_tool0_camera")),
-        T_base_target=PoseEstimate(state.T_base_target, _pose_block(cov, free, "T_base_target")),
-        T_left_right=None
-        if state.T_left_right is None
-        else PoseEstimate(state.T_left_right, _pose_block(cov, free, "T_left_right")),
-        nominal_dh=dh if terms else None,
-        dh_terms=terms,
-        parameter_names=free,
-        covariance=cov,
-        sigma_px=float(np.sqrt(s2)),
-        residual_rms_px=per_cam,
-        views=tuple(views),
-        counts={
-            "views": len(obs.views),
-            "points": n // 2,
-            "residuals": n,
-            "parameters": p,
-            "dof": n - p,
-            "corners_per_view": M,
-        },
-        target={
-            "kind": obs.target.kind,
-            "cols": obs.target.cols,
-            "rows": obs.target.rows,
-            "pitch_m": obs.target.pitch_m,
-        },
-        provenance=prov,
-        created_utc=datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        notes=tuple(notes),
-    )
-
-
 def pose_error(T_est: Array, T_true: Array) -> tuple[float, float]:
     """``(position error (m), rotation angle (rad))`` between two poses."""
     dp = float(np.linalg.norm(T_est[:3, 3] - T_true[:3, 3]))
@@ -376,4 +294,4 @@ def pose_error(T_est: Array, T_true: Array) -> tuple[float, float]:
     return dp, da
 
 
-__all__ = ["CalibrationResult", "SolveOptions", "pose_error", "replace", "solve_calibration"]
+__all__ = ["CalibrationResult", "SolveOptions", "pose_error", "solve_calibration"]

@@ -10,7 +10,7 @@ camera 0.2 mm and 0.02 deg.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -139,11 +139,16 @@ def simulate(
     seed: int = 0,
     with_joints: bool = True,
     source: str = "<synthetic>",
+    flange_sigma_m: float = 0.0,
+    flange_sigma_rad: float = 0.0,
 ) -> CalibrationObservations:
     """Observations of the views ``q_rad`` (V, 6): exact corners plus N(0, noise_px) noise;
     an image where a corner falls outside holds ``None`` (target not seen).
 
     ``with_joints=False`` gives the true flange poses instead of the joints (no kinematics).
+    ``flange_sigma_m``, ``flange_sigma_rad``: each view's flange is off by that much more (per
+    axis, position and rotation about the flange's origin: the arm's repeatability), which the
+    observations do not report.
     """
     rng = np.random.default_rng(seed)
     M = len(truth.target.object_points())
@@ -158,11 +163,18 @@ def simulate(
                 q_rad=np.asarray(q_rad[i], float),
             )
         )
+    T_bt = fk_with_errors(truth.dh, truth.truth.delta, q_rad)
+    T_seen = T_bt.copy()
+    if flange_sigma_m > 0 or flange_sigma_rad > 0:
+        for i in range(V):
+            dR = Rotation.from_rotvec(rng.normal(0.0, flange_sigma_rad, 3)).as_matrix()
+            T_seen[i, :3, :3] = dR @ T_bt[i, :3, :3]
+            T_seen[i, :3, 3] = T_bt[i, :3, 3] + rng.normal(0.0, flange_sigma_m, 3)
+    views = [replace(v, q_rad=None, T_base_tool0=T_seen[i]) for i, v in enumerate(views)]
     blank = CalibrationObservations(tuple(views), truth.target, truth.cameras, source)
-    pred = predict(blank, truth.dh, truth.truth, jac=False)
+    pred = predict(blank, None, truth.truth, jac=False)
     exact = pred.residuals.reshape(-1, M, 2)  # corners minus zero
     n_left = V
-    T_bt = fk_with_errors(truth.dh, truth.truth.delta, q_rad)
     out = []
     w, h = truth.cameras.left.image_size
 

@@ -29,6 +29,15 @@ def print_result(result: CalibrationResult) -> None:
         f"{c['views']} views, {c['points']} corners, {c['parameters']} unknowns, "
         f"corner noise s = {cal.sigma_px:.3f} px (from the residuals)"
     )
+    fs = cal.flange_scatter
+    if fs and not str(fs.get("source", "")).startswith("not modelled"):
+        print(
+            f"flange pose scatter per view {float(fs['sigma_m']) * 1e3:.3f} mm, "
+            f"{np.rad2deg(float(fs['sigma_rad'])):.4f} deg per axis ({fs['source']}): "
+            "in the covariance"
+        )
+    elif fs:
+        print(f"flange pose scatter {fs['source']}: the covariance holds corner noise only")
     width = max(len(v.name) for v in cal.views)
     for v in cal.views:
         right = "" if np.isnan(v.rms_right_px) else f"  right {v.rms_right_px:.3f} px"

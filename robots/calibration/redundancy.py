@@ -87,8 +87,8 @@ def fold_redundant(table: DHTable, delta: np.ndarray) -> tuple[np.ndarray, np.nd
     for every ``q``: exact for ``d1, theta1`` (``C = Rz(theta1) Tz(d1)``) and for the joint-6
     terms of an arm with nominal ``a6 = alpha6 = 0`` (``E = Rz(theta6) Tz(d6) Tx(a6) Rx(alpha6)``);
     ``d_{j+1}`` of parallel axes is added to ``d_j`` (exact when ``alpha_j`` with its error is
-    0, else to second order: about 0.1 um for 0.3 mm and 0.02 deg errors). So a truth compares with a
-    calibration that fixed those terms as ``T_base_target' = inv(C) @ T_base_target`` and
+    0, else to second order: about 0.1 um for 0.3 mm and 0.02 deg errors). A truth compares
+    with a calibration that fixed those terms as ``T_base_target' = inv(C) @ T_base_target`` and
     ``T_tool0_camera' = E @ T_tool0_camera``.
     """
     e = np.array(delta, dtype=float).reshape(6, 4).copy()

@@ -45,6 +45,7 @@ def test_written_and_read_back(solved, tmp_path: Path) -> None:
     assert np.allclose(back.T_tool0_camera.T, cal.T_tool0_camera.T, atol=1e-15)
     assert np.array_equal(back.covariance, cal.covariance)
     assert back.parameter_names == cal.parameter_names and back.provenance == PROV
+    assert back.flange_scatter == cal.flange_scatter and "source" in back.flange_scatter
     assert [t.reason for t in back.dh_terms] == [t.reason for t in cal.dh_terms]
     data = json.loads(path.read_text())
     assert data["format"] == "holecell.cellcal" and data["schema_version"] == 1
