@@ -144,13 +144,15 @@ def main() -> None:
     ap.add_argument("--views", type=int, default=15)
     ap.add_argument("--noise", type=float, default=0.1, help="corner noise (px, one sigma)")
     args = ap.parse_args()
-    for kinematic, title in (
-        (False, "exact flange poses"),
-        (True, "D-H errors (OpenCV: nominal kinematics)"),
-    ):
+    scenarios = (
+        (False, (0.0, 0.0), "exact flange poses"),
+        (True, (0.0, 0.0), "D-H errors (OpenCV: nominal kinematics)"),
+        (True, (20e-6, 40e-6), "D-H errors and 20 um / 40 urad flange scatter per view"),
+    )
+    for kinematic, scatter, title in scenarios:
         rows: dict[str, list] = {}
         for s in range(args.seeds):
-            for k, v in run_seed(s, args.views, args.noise, kinematic).items():
+            for k, v in run_seed(s, args.views, args.noise, kinematic, scatter).items():
                 rows.setdefault(k, []).append(v)
         print(f"\n{title}: {args.seeds} seeds, {args.views} views, {args.noise} px noise")
         print(
@@ -159,7 +161,7 @@ def main() -> None:
         )
         for k, v in rows.items():
             a = np.array(v)
-            med = np.nanmedian(a, axis=0)
+            med = np.array([np.nanmedian(c) if np.isfinite(c).any() else np.nan for c in a.T])
             print(
                 f"{k:<20} {med[0]:12.4f} {med[1]:8.4f} {med[2]:10.4f} {med[3]:8.4f} "
                 f"{med[4]:8.1f}  worst {np.nanmax(a[:, 0]):.4f}"

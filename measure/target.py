@@ -102,9 +102,15 @@ def detect_target(gray: np.ndarray, spec: TargetSpec) -> tuple[np.ndarray | None
     return det.points, det.reason
 
 
-def find_target(gray: np.ndarray, spec: TargetSpec) -> TargetDetection:
+#: the widest edge (10-90 % rise, px) of a target image accepted by default
+MAX_EDGE_WIDTH_PX = 4.0
+
+
+def find_target(
+    gray: np.ndarray, spec: TargetSpec, max_edge_width_px: float = MAX_EDGE_WIDTH_PX
+) -> TargetDetection:
     """Find the target with each detector in turn (:data:`CHESSBOARD_DETECTORS`), then check
-    the corner count and the sharpness of the image."""
+    the corner count and the sharpness of the image (edges up to ``max_edge_width_px``)."""
     img = to_gray8(gray)
     n = spec.cols * spec.rows
     if spec.kind == "chessboard":
@@ -120,7 +126,7 @@ def find_target(gray: np.ndarray, spec: TargetSpec) -> TargetDetection:
         width = float(cv2.estimateChessboardSharpness(img, spec.pattern_size, pts)[0][0])
     else:
         width = _edge_width(img, pts)
-    if width > 4.0:
+    if width > max_edge_width_px:
         return TargetDetection(None, f"too blurred (edge width {width:.1f} px)", detector)
     return TargetDetection(pts.astype(np.float64), "", detector)
 

@@ -96,7 +96,7 @@ def build_calibration(
         notes.append(
             f"covariance: corner noise s = {np.sqrt(s2):.3f} px and each view's flange pose "
             f"scatter {cr.flange_sigma_m * 1e3:.3f} mm, {np.rad2deg(cr.flange_sigma_rad):.4f} deg "
-            f"per axis ({cr.source}), sandwich (J^T J)^-1 J^T Omega J (J^T J)^-1; intrinsics "
+            f"per axis ({cr.source}); {cr.method}; intrinsics "
             "and target geometry taken as exact"
         )
     med = np.nanmedian([v.rms_left_px for v in views])

@@ -9,8 +9,9 @@ pose, position ``sigma_m`` per axis and rotation ``sigma_rad`` per axis (about t
 origin, in ``base_link``), so a view's residuals have the covariance
 ``Omega_v = s^2 I + A_v Sigma A_v^T`` (``A_v``: the view's corners against its flange pose,
 :func:`cell.calibration.model.predict` with ``flange_jac``). The estimate stays the ordinary
-least-squares one; its covariance is the sandwich ``B (sum_v J_v^T Omega_v J_v) B`` with
-``B = (J^T J)^-1``.
+least-squares one with the sandwich ``B (sum_v J_v^T Omega_v J_v) B``, ``B = (J^T J)^-1``;
+:func:`cell.calibration.solve.solve_calibration` then refits by generalised least squares with
+``Omega`` (:class:`ViewWhitening`) and states ``(J^T Omega^-1 J)^-1`` (:func:`gls_covariance`).
 
 Unless given (the arm's repeatability, say), the scatter is estimated from the data by moments,
 with one unknown: ``sigma_m``, the rotation being ``sigma_m / lever_m`` (0.5 m: an arm's
@@ -45,6 +46,7 @@ class CovarianceResult:
     flange_sigma_m: float
     flange_sigma_rad: float
     source: str
+    method: str = "sandwich (J^T J)^-1 J^T Omega J (J^T J)^-1 on the least-squares estimate"
 
 
 def _inverse_normal(J: Array) -> Array:
@@ -59,7 +61,7 @@ def white_covariance(J: Array, r: Array) -> CovarianceResult:
     """Corner noise only: ``s^2 (J^T J)^-1``, ``s^2`` from the residuals over ``n - p``."""
     n, p = J.shape
     s2 = float(r @ r) / (n - p)
-    return CovarianceResult(s2 * _inverse_normal(J), s2, 0.0, 0.0, "not modelled")
+    return CovarianceResult(s2 * _inverse_normal(J), s2, 0.0, 0.0, "not modelled", "s^2 (J^T J)^-1")
 
 
 def flange_scatter_covariance(
@@ -122,3 +124,43 @@ def flange_scatter_covariance(
         meat += G.T @ Sigma @ G
     cov = B @ meat @ B
     return CovarianceResult(0.5 * (cov + cov.T), s2, st, sr, source)
+
+
+class ViewWhitening:
+    """``Omega^(-1/2)`` of the residuals: per view ``(I - Q Q^T) / s + Q C Q^T`` with
+    ``A_v = Q R`` (thin QR) and ``C = (s^2 I + R Sigma R^T)^(-1/2)``; applied to residuals (n,)
+    or Jacobians (n, p), it makes the generalised least squares an ordinary one (weights fixed
+    at the linearisation point)."""
+
+    def __init__(
+        self, F: Array, rows_view: NDArray[np.int64], s2: float, sigma_m: float, sigma_rad: float
+    ) -> None:
+        self.s = float(np.sqrt(s2))
+        Sigma = np.diag([sigma_m**2] * 3 + [sigma_rad**2] * 3)
+        self.blocks = []
+        for v in np.unique(rows_view):
+            sel = np.flatnonzero(rows_view == v)
+            Q, R = np.linalg.qr(F[sel])
+            w, U = np.linalg.eigh(s2 * np.eye(6) + R @ Sigma @ R.T)
+            self.blocks.append((sel, Q, (U / np.sqrt(w)) @ U.T))
+
+    def __call__(self, x: Array) -> Array:
+        out = np.empty_like(x)
+        for sel, Q, C in self.blocks:
+            xs = x[sel]
+            qx = Q.T @ xs
+            out[sel] = (xs - Q @ qx) / self.s + Q @ (C @ qx)
+        return out
+
+
+def gls_covariance(Jw: Array, result: CovarianceResult) -> CovarianceResult:
+    """The covariance of the generalised least-squares estimate, ``(J_w^T J_w)^-1`` with ``J_w``
+    the whitened Jacobian at its solution (same noise and scatter as ``result``)."""
+    return CovarianceResult(
+        _inverse_normal(Jw),
+        result.s2_px,
+        result.flange_sigma_m,
+        result.flange_sigma_rad,
+        result.source,
+        "generalised least squares weighted by Omega^-1, covariance (J^T Omega^-1 J)^-1",
+    )

@@ -18,7 +18,7 @@ import numpy as np
 from cell.calibration.errors import CalibrationDataError
 from cell.calibration.observations import CalibrationObservations, CalibrationView, Cameras
 from cell.calibration.posecsv import PoseRow
-from measure.target import TargetSpec, find_target
+from measure.target import MAX_EDGE_WIDTH_PX, TargetSpec, find_target
 
 log = logging.getLogger(__name__)
 
@@ -34,14 +34,16 @@ def _read_gray(path: Path, src: str, row: int) -> np.ndarray:
     return img
 
 
-def _corners(path: Path, spec: TargetSpec, size: tuple[int, int], src: str, row: int) -> np.ndarray:
+def _corners(
+    path: Path, spec: TargetSpec, size: tuple[int, int], src: str, row: int, blur_px: float
+) -> np.ndarray:
     img = _read_gray(path, src, row)
     h, w = img.shape[:2]
     if (w, h) != tuple(size):
         raise CalibrationDataError(
             src, f"image {path.name} is {w}x{h} px, the calibration is for {size[0]}x{size[1]}", row
         )
-    det = find_target(img, spec)
+    det = find_target(img, spec, blur_px)
     if det.points is None:
         raise CalibrationDataError(src, f"image {path.name}: {det.reason}", row)
     return det.points
@@ -53,8 +55,10 @@ def observations_from_images(
     spec: TargetSpec,
     cameras: Cameras,
     source: str,
+    max_edge_width_px: float = MAX_EDGE_WIDTH_PX,
 ) -> CalibrationObservations:
-    """Detect the target in every row's image(s) and build the observations."""
+    """Detect the target in every row's image(s) and build the observations; an image whose
+    edges are wider than ``max_edge_width_px`` (10-90 % rise) counts as too blurred."""
     folder = Path(images_dir)
     if not folder.is_dir():
         raise CalibrationDataError(str(images_dir), "not a folder of images")
@@ -66,13 +70,18 @@ def observations_from_images(
             source, "mono images (image) with --stereo: give left_image, right_image"
         )
     views = []
+    blur = max_edge_width_px
     for r in rows:
         if stereo_rows:
-            left = _corners(folder / r.left_image, spec, cameras.left.image_size, source, r.row)
-            right = _corners(folder / r.right_image, spec, cameras.right.image_size, source, r.row)
+            left = _corners(
+                folder / r.left_image, spec, cameras.left.image_size, source, r.row, blur
+            )
+            right = _corners(
+                folder / r.right_image, spec, cameras.right.image_size, source, r.row, blur
+            )
             name = f"{r.left_image} / {r.right_image}"
         else:
-            left = _corners(folder / r.image, spec, cameras.left.image_size, source, r.row)
+            left = _corners(folder / r.image, spec, cameras.left.image_size, source, r.row, blur)
             right = None
             name = r.image
         log.info("row %d: target found in %s", r.row, name)

@@ -9,7 +9,7 @@ an image where the target was not found.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -83,7 +83,6 @@ class CalibrationObservations:
     target: TargetSpec
     cameras: Cameras
     source: str = "<memory>"
-    notes: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         n = len(self.target.object_points())

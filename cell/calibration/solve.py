@@ -9,8 +9,9 @@ covariance means what it says) -> :class:`~cell.calibration.result.CellCalibrati
 Covariance of every free unknown (:mod:`cell.calibration.covariance`): the corner noise
 ``s^2`` from the residuals, taken equal in both cameras and independent between corners, plus
 (by default) an independent error of each view's flange pose (the arm's repeatability and
-what the kinematic model leaves out), estimated from the per-view residuals or given: the
-sandwich ``(J^T J)^-1 J^T Omega J (J^T J)^-1`` at the solution. With ``flange_scatter=False``,
+what the kinematic model leaves out), estimated from the per-view residuals or given; with a
+scatter, the fit is repeated by generalised least squares (each view's residuals whitened by
+``Omega_v^-1/2``) and ``(J^T Omega^-1 J)^-1`` is stated. With ``flange_scatter=False``,
 ``s^2 (J^T J)^-1``. The intrinsics are taken as exact (from the stereo calibration file); the
 target's geometry as exact (it fixes the scale).
 """
@@ -19,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,7 +28,12 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from cell.calibration.assemble import build_calibration
-from cell.calibration.covariance import flange_scatter_covariance, white_covariance
+from cell.calibration.covariance import (
+    ViewWhitening,
+    flange_scatter_covariance,
+    gls_covariance,
+    white_covariance,
+)
 from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationError
 from cell.calibration.identifiability import IdentifiabilityReport, choose_free
 from cell.calibration.initial import InitialEstimate, initial_estimate
@@ -195,6 +201,8 @@ def solve_calibration(
         init = initial_estimate(obs, T_bt)
         L = obs.cameras.T_left_right if obs.cameras.stereo else None
         start = State(init.best.T_tool0_camera, init.best.T_base_target, L, np.zeros(24))
+    if start.T_left_right is not None and not obs.corners("right")[1].any():
+        start = replace(start, T_left_right=None)  # no right image saw the plate: mono
     t_init = time.perf_counter()
     stereo = start.T_left_right is not None
     kinematic = dh is not None and obs.has_joints
@@ -218,15 +226,26 @@ def solve_calibration(
         raise DegenerateCalibrationError(f"{n} corner coordinates for {p} unknowns")
     if opts.flange_scatter:
         n_stereo = sum(c.startswith("T_left_right.") for c in report.free)
+        rows_view = np.repeat(pred.view_index, 2)
         cr = flange_scatter_covariance(
             Jf,
             pred.residuals,
             pred.flange_jacobian,
-            np.repeat(pred.view_index, 2),
+            rows_view,
             n_stereo,
             opts.flange_sigma_m,
             opts.flange_sigma_rad,
         )
+        if cr.flange_sigma_m > 0 or cr.flange_sigma_rad > 0:
+            # the views' corners move together: weight by Omega^-1 (generalised least squares)
+            weight = ViewWhitening(
+                pred.flange_jacobian, rows_view, cr.s2_px, cr.flange_sigma_m, cr.flange_sigma_rad
+            )
+            state = _fit(obs, dh, state, report.free, opts, weight)
+            _check_plausible(obs, state, report.free, opts)
+            pred = predict(obs, dh, state)
+            Jf = pred.jacobian[:, [columns.index(c) for c in report.free]]
+            cr = gls_covariance(weight(Jf), cr)
     else:
         cr = white_covariance(Jf, pred.residuals)
     t_end = time.perf_counter()
@@ -271,12 +290,18 @@ def _fit(
     start: State,
     free: tuple[str, ...],
     opts: SolveOptions,
+    weight: ViewWhitening | None = None,
 ) -> State:
+    """Least squares over the free unknowns from ``start``; ``weight`` whitens the residuals
+    (generalised least squares with the views' flange scatter)."""
     prob = _Problem(obs, dh, start, free)
+    fun, jac = prob.residuals, prob.jacobian
+    if weight is not None:
+        fun, jac = (lambda x: weight(prob.residuals(x))), (lambda x: weight(prob.jacobian(x)))
     sol = least_squares(
-        prob.residuals,
+        fun,
         np.zeros(len(free)),
-        jac=prob.jacobian,
+        jac=jac,
         method="lm",
         x_scale="jac",
         xtol=1e-12,

@@ -47,6 +47,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--no-kinematics", action="store_true", help="do not estimate the D-H errors (joints rows)"
     )
     p.add_argument(
+        "--max-edge-width",
+        type=float,
+        default=4.0,
+        metavar="PX",
+        help="widest edge (10-90 %% rise, px) of an image accepted as sharp (4)",
+    )
+    p.add_argument(
         "--fixed-stereo",
         action="store_true",
         help="take the stereo extrinsics from stereo.json as exact instead of estimating them",
@@ -110,7 +117,13 @@ def run(args: argparse.Namespace) -> int:
         left = read_intrinsics(args.intrinsics, size)
         cameras = Cameras(left=left, source=args.intrinsics)
         content = {"K": left.K.tolist(), "dist": left.dist.tolist(), "size": list(left.image_size)}
-    obs = observations_from_images(rows, args.images, spec, cameras, args.poses)
+    if not 0 < args.max_edge_width <= 50:
+        raise CalibrationDataError(
+            "--max-edge-width", f"{args.max_edge_width:g} px is not in (0, 50]"
+        )
+    obs = observations_from_images(
+        rows, args.images, spec, cameras, args.poses, args.max_edge_width
+    )
     opts = SolveOptions(
         estimate_kinematics=not args.no_kinematics, estimate_stereo=not args.fixed_stereo
     )

@@ -173,3 +173,21 @@ def test_calibrate_stereo_and_the_older_form_reach_the_stereo_calibration(capsys
     assert old.left == new.left == ["l*.png"] and old.pitch == 0.012
     assert main(["calibrate"]) == 2
     assert "give a subcommand (stereo, hand-eye)" in capsys.readouterr().err
+
+
+def test_a_blurred_image_is_refused_unless_a_wider_edge_is_allowed(
+    rendered, tmp_path: Path, capsys
+) -> None:
+    def blur(rows, d):
+        img = cv2.imread(str(d / rows[2][0]), cv2.IMREAD_GRAYSCALE)
+        cv2.imwrite(str(d / rows[2][0]), cv2.GaussianBlur(img, (0, 0), 2.0))
+
+    _tr, folder = rendered
+    d, poses = _edited(rendered, tmp_path, "flange", blur)
+    out = tmp_path / "cellcal.json"
+    stereo = ["--stereo", str(folder / "stereo.json")]
+    assert _run(d, poses, out, *stereo) == 2
+    assert "row 2: image L01.png: too blurred (edge width" in capsys.readouterr().err
+    assert not out.exists()
+    assert _run(d, poses, out, *stereo, "--max-edge-width", "8") == 0
+    assert load_calibration(out).counts["views"] == 10

@@ -181,3 +181,14 @@ def test_the_stated_sigmas_are_honest_with_pose_scatter_monte_carlo() -> None:
     within = np.mean(np.abs(z) < 2.0)
     assert 0.92 <= within <= 0.98, within
     assert 0.8 < ratio.mean() < 1.4, ratio.mean()
+
+
+def test_a_stereo_head_whose_right_camera_saw_nothing_is_solved_as_mono() -> None:
+    from dataclasses import replace as dc_replace
+
+    tr, obs = _data(5, 10)
+    views = tuple(dc_replace(v, corners_right_px=None) for v in obs.views)
+    res = solve_calibration(dc_replace(obs, views=views), tr.dh)
+    assert res.calibration.T_left_right is None
+    assert not any(n.startswith("T_left_right.") for n in res.calibration.parameter_names)
+    assert set(res.calibration.residual_rms_px) == {"left"}
