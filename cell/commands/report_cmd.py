@@ -29,5 +29,5 @@ def run_report(args: argparse.Namespace) -> int:
     """Handler of ``holecell report``."""
     summ = write_report(args.run_dir, args.operator)
     print(format_summary(summ))
-    print(f"wrote {args.run_dir}/report.json, report.csv and report.html")
+    print(f"wrote {args.run_dir}/report.json, report.csv, report.qif and report.html")
     return 0

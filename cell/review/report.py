@@ -20,6 +20,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from cell.review.qif.run_file import write_run_qif
 from cell.review.report_html import render_html
 from cell.review.store import Store
 from cell.run.results import HoleResult
@@ -118,7 +119,8 @@ def _components(r: HoleResult) -> dict[str, Any]:
 
 
 def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
-    """Write ``report.json``, ``report.csv`` and ``report.html`` (the inspection protocol,
+    """Write ``report.json``, ``report.csv``, ``report.qif`` (QIF 3.0, :mod:`cell.review.qif`)
+    and ``report.html`` (the inspection protocol,
     :mod:`cell.review.report_html`; ``operator`` fills its operator field) into ``run_dir``;
     returns the summary."""
     run_dir = Path(run_dir)
@@ -134,6 +136,7 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events}  # fmt: skip
     (run_dir / "report.json").write_text(json.dumps(doc, indent=1))
+    write_run_qif(doc, run_dir, info, results)  # QIF 3.0 results (cell.review.qif)
     with (run_dir / "report.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS)
         w.writeheader()

@@ -30,24 +30,40 @@ from cell.review.qif.features import FeatureIds
 from cell.review.qif.xmlutil import Ids, counted, dec, ids_list, sub
 
 #: report decision -> QIF CharacteristicStatusEnum
-STATUS = {"conformance": "PASS", "nonconformance": "FAIL", "inconclusive": "INDETERMINATE",
-          "not_evaluated": "NOT_ANALYZED"}  # fmt: skip
+STATUS = {
+    "conformance": "PASS",
+    "nonconformance": "FAIL",
+    "inconclusive": "INDETERMINATE",
+    "not_evaluated": "NOT_ANALYZED",
+}
 MATERIAL = {"RFS": "REGARDLESS", "MMC": "MAXIMUM", "LMC": "LEAST"}
 KINDS = {"diameter": "Diameter", "position": "Position"}
 
 
 def _kind(c: Mapping[str, Any]) -> str:
     if c.get("kind") not in KINDS:
-        raise QifError("report", [f"characteristic {c.get('id')!r}: kind {c.get('kind')!r} "
-                                  f"is not one of {sorted(KINDS)}"])  # fmt: skip
+        raise QifError(
+            "report",
+            [
+                f"characteristic {c.get('id')!r}: kind {c.get('kind')!r} "
+                f"is not one of {sorted(KINDS)}"
+            ],
+        )
     return KINDS[c["kind"]]
 
 
-def characteristic_section(root: etree._Element, chars: Sequence[Mapping[str, Any]],
-                           features: Mapping[str, FeatureIds], drf_ids: Mapping[str, int],
-                           standard_id: int, ids: Ids) -> dict[str, tuple[int, int]]:  # fmt: skip
+def characteristic_section(
+    root: etree._Element,
+    chars: Sequence[Mapping[str, Any]],
+    features: Mapping[str, FeatureIds],
+    drf_ids: Mapping[str, int],
+    standard_id: int,
+    ids: Ids,
+) -> dict[str, tuple[int, int]]:
     """``<Characteristics>`` (under the standard ``standard_id``); returns characteristic id ->
-    (definition id, item id)."""
+    (definition id, item id); nothing without characteristics."""
+    if not chars:
+        return {}
     sec = sub(root, "Characteristics")
     sub(sec, "FormalStandardId", str(standard_id))
     defs = counted(sec, "CharacteristicDefinitions")
@@ -82,8 +98,9 @@ def characteristic_section(root: etree._Element, chars: Sequence[Mapping[str, An
     return out
 
 
-def _position_definition(d: etree._Element, c: Mapping[str, Any], drf_ids: Mapping[str, int],
-                         size_def: Mapping[str, int]) -> None:  # fmt: skip
+def _position_definition(
+    d: etree._Element, c: Mapping[str, Any], drf_ids: Mapping[str, int], size_def: Mapping[str, int]
+) -> None:
     sub(d, "ToleranceValue", dec(c["zone_diameter_m"]))
     if c.get("drf") is not None:
         if c["drf"] not in drf_ids:
@@ -105,18 +122,24 @@ def _value(parent: etree._Element, tag: str, v: float, U: float | None) -> None:
         e.set("meanError", "0")
 
 
-def characteristic_measurements(mc: etree._Element, chars: Sequence[Mapping[str, Any]],
-                                item_ids: Mapping[str, tuple[int, int]],
-                                features: Mapping[str, FeatureIds],
-                                transform_ids: Mapping[str, int], ids: Ids,
-                                timestamp: str | None = None) -> None:  # fmt: skip
+def characteristic_measurements(
+    mc: etree._Element,
+    chars: Sequence[Mapping[str, Any]],
+    item_ids: Mapping[str, tuple[int, int]],
+    features: Mapping[str, FeatureIds],
+    transform_ids: Mapping[str, int],
+    ids: Ids,
+    timestamp: str | None = None,
+) -> None:
     """Fill ``<CharacteristicMeasurements>`` ``mc``: one measurement per characteristic
     (``timestamp``: the run's start as ``xs:dateTime``, UTC)."""
     for c in chars:
         k, decision = _kind(c), c.get("decision")
         if decision not in STATUS:
-            raise QifError("report", [f"characteristic {c['id']}: decision {decision!r} is "
-                                      f"not one of {sorted(STATUS)}"])  # fmt: skip
+            raise QifError(
+                "report",
+                [f"characteristic {c['id']}: decision {decision!r} is not one of {sorted(STATUS)}"],
+            )
         m = sub(mc, f"{k}CharacteristicMeasurement", id=str(ids.next()))
         evaluated = decision != "not_evaluated" and c.get("value_m") is not None
         reason = " ".join(str(c.get("reason") or "").split())

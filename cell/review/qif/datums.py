@@ -42,10 +42,15 @@ def pose_matrix(pose: Mapping[str, Any], what: str) -> np.ndarray:
     return T
 
 
-def datum_definitions(root: etree._Element, datums: Sequence[Mapping[str, Any]],
-                      holes: Mapping[str, Mapping[str, Any]], features: Mapping[str, FeatureIds],
-                      feature_lists: tuple[etree._Element, ...],
-                      normals: Mapping[str, Sequence[float]], ids: Ids) -> dict[str, int]:  # fmt: skip
+def datum_definitions(
+    root: etree._Element,
+    datums: Sequence[Mapping[str, Any]],
+    holes: Mapping[str, Mapping[str, Any]],
+    features: Mapping[str, FeatureIds],
+    feature_lists: tuple[etree._Element, ...],
+    normals: Mapping[str, Sequence[float]],
+    ids: Ids,
+) -> dict[str, int]:
     """``<DatumDefinitions>``; returns datum label -> its QIF id."""
     defs = counted(root, "DatumDefinitions")
     out: dict[str, int] = {}
@@ -70,9 +75,13 @@ def datum_definitions(root: etree._Element, datums: Sequence[Mapping[str, Any]],
     return out
 
 
-def reference_frames(root: etree._Element, frames: Sequence[Mapping[str, Any]],
-                     datums: Sequence[Mapping[str, Any]], datum_ids: Mapping[str, int],
-                     ids: Ids) -> dict[str, int]:  # fmt: skip
+def reference_frames(
+    root: etree._Element,
+    frames: Sequence[Mapping[str, Any]],
+    datums: Sequence[Mapping[str, Any]],
+    datum_ids: Mapping[str, int],
+    ids: Ids,
+) -> dict[str, int]:
     """``<DatumReferenceFrames>``; returns DRF name -> its QIF id."""
     kind = {d["label"]: d["kind"] for d in datums}
     drfs = counted(root, "DatumReferenceFrames")
@@ -107,9 +116,13 @@ def _transform(parent: etree._Element, T: np.ndarray, name: str, ids: Ids) -> in
     return tid
 
 
-def actual_transforms(lst: etree._Element, top: etree._Element,
-                      frames: Sequence[Mapping[str, Any]], placement: Mapping[str, Any] | None,
-                      ids: Ids) -> dict[str, int]:  # fmt: skip
+def actual_transforms(
+    lst: etree._Element,
+    top: etree._Element,
+    frames: Sequence[Mapping[str, Any]],
+    placement: Mapping[str, Any] | None,
+    ids: Ids,
+) -> dict[str, int]:
     """Fill ``<ActualTransforms>`` ``lst`` of the results: ``T_part_drf`` of every evaluated
     DRF (named ``<DRF> T_part_drf``) and the part's placement ``T_fixture_part``.
 

@@ -17,8 +17,8 @@ characteristics (no drawing tolerances evaluated) is NOT_CALCULATED.
 from __future__ import annotations
 
 import uuid
-from datetime import UTC, datetime
 from collections.abc import Mapping, Sequence
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -48,8 +48,11 @@ def inspection_status(chars: Sequence[Mapping[str, Any]]) -> str:
 
 def _header(root: etree._Element, report: Mapping[str, Any], ids: Ids) -> int:
     summ = report.get("summary") or {}
-    sub(root, "QPId", str(uuid.uuid5(_QPID_NAMESPACE,
-                                     f"{summ.get('cell_sha256')}/{summ.get('started_at')}")))  # fmt: skip
+    sub(
+        root,
+        "QPId",
+        str(uuid.uuid5(_QPID_NAMESPACE, f"{summ.get('cell_sha256')}/{summ.get('started_at')}")),
+    )
     app = sub(sub(root, "Header"), "Application")
     sub(app, "Name", "holecell")
     sub(app, "Organization", "holecell")
@@ -84,14 +87,20 @@ def _prune(root: etree._Element) -> None:
         changed = False
         for e in list(root.iter()):
             empty = len(e) == 0 and not (e.text or "").strip() and e is not root
-            if empty and (e.get("n") == "0" or etree.QName(e).localname in
-                          ("MeasuredCharacteristics", "Features", "Characteristics")):  # fmt: skip
+            if empty and (
+                e.get("n") == "0"
+                or etree.QName(e).localname
+                in ("MeasuredCharacteristics", "Features", "Characteristics")
+            ):
                 e.getparent().remove(e)
                 changed = True
 
 
-def build_qif(report: Mapping[str, Any], nominal_normals: Mapping[str, Sequence[float]],
-              measured_normals: Mapping[str, Sequence[float]] | None = None) -> etree._Element:  # fmt: skip
+def build_qif(
+    report: Mapping[str, Any],
+    nominal_normals: Mapping[str, Sequence[float]],
+    measured_normals: Mapping[str, Sequence[float]] | None = None,
+) -> etree._Element:
     """The ``QIFDocument`` of a report.json mapping (``holes`` plus, when present, ``datums``,
     ``datum_reference_frames``, ``placement`` and ``characteristics``). ``nominal_normals``:
     hole id -> nominal axis (the cell file's ``normal``, part frame); ``measured_normals``:
@@ -102,8 +111,7 @@ def build_qif(report: Mapping[str, Any], nominal_normals: Mapping[str, Sequence[
     datums = list(report.get("datums") or [])
     frames = list(report.get("datum_reference_frames") or [])
     chars = list(report.get("characteristics") or [])
-    root = etree.Element(f"{{{NS}}}QIFDocument", nsmap={None: NS},
-                         versionQIF=QIF_VERSION)  # fmt: skip
+    root = etree.Element(f"{{{NS}}}QIFDocument", nsmap={None: NS}, versionQIF=QIF_VERSION)
     std_id = _header(root, report, ids)
     # the Features section comes after the datums in the file but datums refer to features:
     # build features detached, then place every section in the schema's order
@@ -115,15 +123,19 @@ def build_qif(report: Mapping[str, Any], nominal_normals: Mapping[str, Sequence[
     drf_ids = reference_frames(root, frames, datums, datum_ids, ids)
     root.append(feats_holder[0])
     item_ids = characteristic_section(root, chars, features, drf_ids, std_id, ids)
-    mr = sub(counted(sub(root, "Results"), "MeasurementResultsSet"), "MeasurementResults",
-             id=str(ids.next()))  # fmt: skip
+    mr = sub(
+        counted(sub(root, "Results"), "MeasurementResultsSet"),
+        "MeasurementResults",
+        id=str(ids.next()),
+    )
     mf = counted(mr, "MeasuredFeatures")
     mc = counted(sub(mr, "MeasuredCharacteristics"), "CharacteristicMeasurements")
     at = counted(mr, "ActualTransforms")
     measured_features(mf, holes, features, measured_normals or {}, ids)
     transform_ids = actual_transforms(at, top_transforms, frames, report.get("placement"), ids)
-    characteristic_measurements(mc, chars, item_ids, features, transform_ids, ids,
-                                _timestamp(report))  # fmt: skip
+    characteristic_measurements(
+        mc, chars, item_ids, features, transform_ids, ids, _timestamp(report)
+    )
     sub(sub(mr, "InspectionStatus"), "InspectionStatusEnum", inspection_status(chars))
     _prune(root)
     finish_counts(root)
@@ -131,16 +143,20 @@ def build_qif(report: Mapping[str, Any], nominal_normals: Mapping[str, Sequence[
     return root
 
 
-def write_qif(report: Mapping[str, Any], path: str | Path,
-              nominal_normals: Mapping[str, Sequence[float]],
-              measured_normals: Mapping[str, Sequence[float]] | None = None) -> Path:  # fmt: skip
+def write_qif(
+    report: Mapping[str, Any],
+    path: str | Path,
+    nominal_normals: Mapping[str, Sequence[float]],
+    measured_normals: Mapping[str, Sequence[float]] | None = None,
+) -> Path:
     """Build, validate (raises :class:`~cell.review.qif.errors.QifError`) and write
     ``report.qif`` to ``path`` (atomically: a reader never sees half a file)."""
     path = Path(path)
     root = build_qif(report, nominal_normals, measured_normals)
     validate_tree(root, str(path))
     tmp = path.with_name(path.name + ".tmp")
-    etree.ElementTree(root).write(str(tmp), xml_declaration=True, encoding="UTF-8",
-                                  pretty_print=True)  # fmt: skip
+    etree.ElementTree(root).write(
+        str(tmp), xml_declaration=True, encoding="UTF-8", pretty_print=True
+    )
     tmp.replace(path)
     return path

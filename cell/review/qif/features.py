@@ -51,14 +51,17 @@ def _unit(v: Sequence[float], what: str) -> np.ndarray:
     return a / n
 
 
-def plane_through(holes: Sequence[Mapping[str, Any]],
-                  normals: Mapping[str, Sequence[float]]) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def plane_through(
+    holes: Sequence[Mapping[str, Any]], normals: Mapping[str, Sequence[float]]
+) -> tuple[np.ndarray, np.ndarray]:
     """The least-squares plane through the holes' nominal centres: (point, unit normal), the
     normal on the side of the holes' mean nominal axis (for fewer than three holes: the point
     is their centroid and the normal their mean axis)."""
     pts = np.array([nominal_centre(h) for h in holes])
-    mean_axis = _unit(np.sum([_unit(normals[h["hole_id"]], h["hole_id"]) for h in holes], 0),
-                      "mean axis of the plane's holes")  # fmt: skip
+    mean_axis = _unit(
+        np.sum([_unit(normals[h["hole_id"]], h["hole_id"]) for h in holes], 0),
+        "mean axis of the plane's holes",
+    )
     centroid = pts.mean(axis=0)
     if len(pts) < 3:
         return centroid, mean_axis
@@ -67,9 +70,14 @@ def plane_through(holes: Sequence[Mapping[str, Any]],
     return centroid, (n if n @ mean_axis >= 0 else -n)
 
 
-def hole_features(definitions: etree._Element, nominals: etree._Element,
-                  items: etree._Element, holes: Sequence[Mapping[str, Any]],
-                  normals: Mapping[str, Sequence[float]], ids: Ids) -> dict[str, FeatureIds]:  # fmt: skip
+def hole_features(
+    definitions: etree._Element,
+    nominals: etree._Element,
+    items: etree._Element,
+    holes: Sequence[Mapping[str, Any]],
+    normals: Mapping[str, Sequence[float]],
+    ids: Ids,
+) -> dict[str, FeatureIds]:
     """A circle definition, nominal and item per hole (internal, at the nominal diameter)."""
     out: dict[str, FeatureIds] = {}
     for h in holes:
@@ -92,9 +100,15 @@ def hole_features(definitions: etree._Element, nominals: etree._Element,
     return out
 
 
-def plane_feature(definitions: etree._Element, nominals: etree._Element,
-                  items: etree._Element, name: str, point: np.ndarray, normal: np.ndarray,
-                  ids: Ids) -> FeatureIds:  # fmt: skip
+def plane_feature(
+    definitions: etree._Element,
+    nominals: etree._Element,
+    items: etree._Element,
+    name: str,
+    point: np.ndarray,
+    normal: np.ndarray,
+    ids: Ids,
+) -> FeatureIds:
     """A plane definition, nominal (``point``, ``normal`` in the part frame) and item."""
     f = FeatureIds(ids.next(), ids.next(), ids.next())
     sub(definitions, "PlaneFeatureDefinition", id=str(f.definition))
@@ -112,13 +126,20 @@ def plane_feature(definitions: etree._Element, nominals: etree._Element,
 def features_section(root: etree._Element) -> tuple[etree._Element, ...]:
     """``<Features>`` with its three lists (definitions, nominals, items)."""
     feats = sub(root, "Features")
-    return (counted(feats, "FeatureDefinitions"), counted(feats, "FeatureNominals"),
-            counted(feats, "FeatureItems"))  # fmt: skip
+    return (
+        counted(feats, "FeatureDefinitions"),
+        counted(feats, "FeatureNominals"),
+        counted(feats, "FeatureItems"),
+    )
 
 
-def measured_features(mf: etree._Element, holes: Sequence[Mapping[str, Any]],
-                      features: Mapping[str, FeatureIds],
-                      measured_normals: Mapping[str, Sequence[float]], ids: Ids) -> None:  # fmt: skip
+def measured_features(
+    mf: etree._Element,
+    holes: Sequence[Mapping[str, Any]],
+    features: Mapping[str, FeatureIds],
+    measured_normals: Mapping[str, Sequence[float]],
+    ids: Ids,
+) -> None:
     """Fill ``<MeasuredFeatures>`` ``mf``: a circle measurement per measured hole (centre with
     ``combinedUncertainty`` = U_position/2, the measured axis when known, diameter with
     ``combinedUncertainty`` = U_diameter/2; k = 2 is the report's coverage factor)."""
