@@ -24,7 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directories or folders")
     p.add_argument(
-        "--out", default=None, help="output folder (default: the folder given, if one; else .)"
+        "--out", default=None, help="output folder (default: the one RUN_DIR or folder given; else .)"
     )
     p.set_defaults(handler=run_spc)
 
@@ -33,10 +33,11 @@ def run_spc(args: argparse.Namespace) -> int:
     """Handler of ``holecell spc``."""
     runs = read_runs(args.run_dirs)
     results = analyse(series(runs))
-    one = len(args.run_dirs) == 1 and not (Path(args.run_dirs[0]) / "report.qif").is_file()
-    out = args.out or (args.run_dirs[0] if one else ".")
+    out = args.out or (args.run_dirs[0] if len(args.run_dirs) == 1 else ".")
     csv_path, html_path = write_spc(results, [str(Path(r.path).parent) for r in runs], out)
     print(f"{len(runs)} runs, {len(results)} characteristics")
+    if not results:
+        print("  (the runs' report.qif carry no characteristics: no drawing tolerances evaluated)")
     for s, cap, why in results:
         if cap is None:
             print(f"  {s.name:<22} {why}")
