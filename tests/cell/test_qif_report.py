@@ -18,7 +18,7 @@ from test_cell_report_html import _result
 
 from cell.review.qif import QifError, build_qif, inspection_status, validate_file, write_qif
 from cell.review.qif.read import read_qif
-from cell.review.qif.schema import SCHEMA_DIR, qif_schema
+from cell.review.qif.validator import SCHEMA_DIR, qif_schema
 from cell.review.report import write_report
 from cell.run.setup import start_run
 

@@ -27,7 +27,7 @@ from lxml import etree
 from cell.review.qif.characteristics import characteristic_measurements, characteristic_section
 from cell.review.qif.datums import actual_transforms, datum_definitions, reference_frames
 from cell.review.qif.features import features_section, hole_features, measured_features
-from cell.review.qif.schema import NS, validate_tree
+from cell.review.qif.validator import NS, validate_tree
 from cell.review.qif.xmlutil import Ids, counted, finish_counts, sub
 
 QIF_VERSION = "3.0.0"

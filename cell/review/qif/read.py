@@ -14,7 +14,7 @@ import numpy as np
 from lxml import etree
 
 from cell.review.qif.errors import QifError
-from cell.review.qif.schema import NS, validate_file
+from cell.review.qif.validator import NS, validate_file
 
 _NS = {"q": NS}
 MATERIAL_BACK = {"REGARDLESS": "RFS", "MAXIMUM": "MMC", "LEAST": "LMC"}

@@ -12,7 +12,7 @@ from decimal import Decimal
 
 from lxml import etree
 
-from cell.review.qif.schema import NS
+from cell.review.qif.validator import NS
 
 Q = f"{{{NS}}}"
 
