@@ -2,7 +2,7 @@
 
 The schemas are loaded once per process from the package folder (no network: the W3C
 signature schema is the QIF community's local copy in the qif3 namespace); loading takes about
-a second, a validation of a run's ``report.qif`` some milliseconds.
+0.2 s, validating a run's ``report.qif`` (41 holes) about 60 ms.
 """
 
 from __future__ import annotations
