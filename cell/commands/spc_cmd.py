@@ -24,7 +24,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directories or folders")
     p.add_argument(
-        "--out", default=None, help="output folder (default: the one RUN_DIR or folder given; else .)"
+        "--out",
+        default=None,
+        help="output folder (default: the one RUN_DIR or folder given; else .)",
     )
     p.set_defaults(handler=run_spc)
 
@@ -38,9 +40,10 @@ def run_spc(args: argparse.Namespace) -> int:
     print(f"{len(runs)} runs, {len(results)} characteristics")
     if not results:
         print("  (the runs' report.qif carry no characteristics: no drawing tolerances evaluated)")
-    for s, cap, why in results:
+    for a in results:
+        s, cap = a.series, a.cap
         if cap is None:
-            print(f"  {s.name:<22} {why}")
+            print(f"  {s.name:<22} {a.why}")
         else:
             cpk = "-" if cap.cpk is None else f"{cap.cpk:.2f}"
             print(

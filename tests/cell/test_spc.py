@@ -13,6 +13,7 @@ from qif_reports import NORMALS, gdt_report
 
 from cell.cli import main
 from cell.review.qif import write_qif
+from cell.review.spc.bounded import rice_cpk
 from cell.review.spc.stats import capability
 
 N_RUNS = 40
@@ -66,6 +67,11 @@ def test_cpk_of_a_known_process_within_its_sampling_error(tmp_path: Path, capsys
     assert rows["H1.position"]["cp"] == "" and rows["H1.position"]["lsl_m"] == ""
     assert abs(got - want) < 3 * _cpk_se(want, N_RUNS), (got, want)
     assert float(rows["H1.position"]["lcl_m"]) >= 0.0
+    # the Rice fit's percentile index against the process's own percentiles; its spread at 40
+    # runs is 0.28 (measured over 500 samples of this process; mean 2.28 against 2.20)
+    x50, xu = np.quantile(v, [0.5, 0.99865])
+    want = (ZONE_M - x50) / (xu - x50)
+    assert abs(float(rows["H1.position"]["cpk_rice"]) - want) < 3 * 0.28
     assert rows["H2.position"]["n"] == "0" and rows["H2.position"]["n_not_evaluated"] == "40"
     assert "H1.diameter" in capsys.readouterr().out
 
@@ -134,3 +140,20 @@ def test_refusals(tmp_path: Path, capsys) -> None:
     (runs / "run002" / "report.qif").write_text(text.replace("PASS", "GREAT"))
     assert main(["spc", str(runs)]) == 2
     assert "run002/report.qif: line" in capsys.readouterr().err
+
+
+def test_rice_cpk_is_the_normal_one_far_from_zero_and_lower_near_it() -> None:
+    rng = np.random.default_rng(4)
+    far = 2 * np.hypot(rng.normal(2e-4, 1e-5, 4000), rng.normal(0.0, 1e-5, 4000))
+    fit = rice_cpk(far, 5e-4)
+    assert fit.cpk == pytest.approx((5e-4 - far.mean()) / (3 * far.std()), rel=0.05)
+    assert fit.nu_m == pytest.approx(2e-4, rel=0.02) and fit.sigma_m == pytest.approx(
+        1e-5, rel=0.05
+    )
+    centred = 2 * np.hypot(rng.normal(0.0, 1e-5, 4000), rng.normal(0.0, 1e-5, 4000))
+    normal_cpk = (5e-4 - centred.mean()) / (3 * centred.std())
+    x50, xu = np.quantile(centred, [0.5, 0.99865])
+    fit = rice_cpk(centred, 5e-4)
+    assert fit.cpk == pytest.approx((5e-4 - x50) / (xu - x50), rel=0.08)
+    assert fit.cpk < 0.9 * normal_cpk  # the long upper tail the normal index ignores
+    assert rice_cpk(np.full(10, 1e-5), 5e-4) is None and rice_cpk([1e-5] * 4, 5e-4) is None
