@@ -136,12 +136,12 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events}  # fmt: skip
     (run_dir / "report.json").write_text(json.dumps(doc, indent=1))
-    write_run_qif(doc, run_dir, info, results)  # QIF 3.0 results (cell.review.qif)
     with (run_dir / "report.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS)
         w.writeheader()
         for row in rows:
             w.writerow({k: ("" if v is None else v) for k, v in row.items()})
+    write_run_qif(doc, run_dir, info, results)  # QIF 3.0 results (cell.review.qif)
     return summ
 
 
