@@ -175,3 +175,24 @@ def test_every_run_writes_a_valid_report_qif_equal_to_report_json(
     tree = etree.parse(str(tmp_path / "report.qif"))
     nominal = tree.getroot().findall(".//{*}CircleFeatureNominal")
     assert len(nominal) == len(doc["holes"])
+
+
+def test_a_best_fit_and_the_fixture_frame_are_no_drf(tmp_path: Path) -> None:
+    """A best-fit alignment (``ALIGN``, no datums) and the fixture frame of a cell without
+    datums: the positions carry no DRF, the best fit's transform is still in the results."""
+    report = gdt_report(np.random.default_rng(5), missing=())
+    report["datum_reference_frames"][0].update(id="ALIGN", datums=[])
+    report["datums"] = []
+    for c in report["characteristics"]:
+        if c["kind"] == "position":
+            c["drf"], c["datums"] = ("ALIGN", []) if c["hole_id"] == "H1" else ("fixture", [])
+    got = read_qif(write_qif(report, tmp_path / "report.qif", NORMALS))
+    assert {c.name for c in got.characteristics} >= {"H1.position", "H2.position"}
+    assert all(c.drf_transform is None for c in got.characteristics)
+    assert "ALIGN T_part_drf" in got.transforms
+    root = etree.parse(str(tmp_path / "report.qif")).getroot()
+    assert root.find("{*}DatumReferenceFrames") is None
+    assert root.find(".//{*}PositionCharacteristicDefinition/{*}DatumReferenceFrameId") is None
+    report["characteristics"][1]["drf"] = "DRF9"
+    with pytest.raises(QifError, match=r"H1\.position: unknown DRF 'DRF9'"):
+        write_qif(report, tmp_path / "r.qif", NORMALS)

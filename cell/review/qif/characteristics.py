@@ -20,7 +20,7 @@ hole's circle feature item.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from typing import Any
 
 from lxml import etree
@@ -59,6 +59,7 @@ def characteristic_section(
     drf_ids: Mapping[str, int],
     standard_id: int,
     ids: Ids,
+    other_frames: Collection[str] = ("fixture",),
 ) -> dict[str, tuple[int, int]]:
     """``<Characteristics>`` (under the standard ``standard_id``); returns characteristic id ->
     (definition id, item id); nothing without characteristics."""
@@ -84,7 +85,7 @@ def characteristic_section(
             sub(tol, "MinValue", dec(c["lower_m"]))
             sub(tol, "DefinedAsLimit", "false")
         else:
-            _position_definition(d, c, drf_ids, size_def)
+            _position_definition(d, c, drf_ids, size_def, other_frames)
         n = sub(noms, f"{k}CharacteristicNominal", id=str(n_id))
         sub(n, "CharacteristicDefinitionId", str(d_id))
         sub(n, "Name", name)
@@ -99,13 +100,20 @@ def characteristic_section(
 
 
 def _position_definition(
-    d: etree._Element, c: Mapping[str, Any], drf_ids: Mapping[str, int], size_def: Mapping[str, int]
+    d: etree._Element,
+    c: Mapping[str, Any],
+    drf_ids: Mapping[str, int],
+    size_def: Mapping[str, int],
+    other_frames: Collection[str],
 ) -> None:
+    """A position definition; evaluated in a frame that is no DRF (``fixture``: the nominal
+    part frame; a best fit) it carries no ``DatumReferenceFrameId``."""
     sub(d, "ToleranceValue", dec(c["zone_diameter_m"]))
-    if c.get("drf") is not None:
-        if c["drf"] not in drf_ids:
-            raise QifError("report", [f"characteristic {c['id']}: unknown DRF {c['drf']!r}"])
-        sub(d, "DatumReferenceFrameId", str(drf_ids[c["drf"]]))
+    drf = c.get("drf")
+    if drf is not None and drf not in other_frames:
+        if drf not in drf_ids:
+            raise QifError("report", [f"characteristic {c['id']}: unknown DRF {drf!r}"])
+        sub(d, "DatumReferenceFrameId", str(drf_ids[drf]))
     mc = c.get("material_condition") or "RFS"
     if mc not in MATERIAL:
         raise QifError("report", [f"characteristic {c['id']}: material_condition {mc!r}"])

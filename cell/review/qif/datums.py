@@ -82,14 +82,17 @@ def reference_frames(
     datum_ids: Mapping[str, int],
     ids: Ids,
 ) -> dict[str, int]:
-    """``<DatumReferenceFrames>``; returns DRF name -> its QIF id."""
+    """``<DatumReferenceFrames>``; returns DRF name -> its QIF id. A frame without datums (a
+    best-fit alignment, ``ALIGN``) is no DRF: it gets no entry here, only its transform."""
     kind = {d["label"]: d["kind"] for d in datums}
     drfs = counted(root, "DatumReferenceFrames")
     out: dict[str, int] = {}
     for fr in frames:
-        labels = list(fr["datums"])
+        labels = list(fr.get("datums") or [])
+        if not labels:
+            continue
         missing = [lab for lab in labels if lab not in datum_ids]
-        if missing or not labels or len(labels) > len(PRECEDENCE):
+        if missing or len(labels) > len(PRECEDENCE):
             raise QifError("report", [f"DRF {fr['id']}: datums {labels} (unknown: {missing})"])
         out[fr["id"]] = ids.next()
         e = sub(drfs, "DatumReferenceFrame", id=str(out[fr["id"]]))
@@ -124,17 +127,20 @@ def actual_transforms(
     ids: Ids,
 ) -> dict[str, int]:
     """Fill ``<ActualTransforms>`` ``lst`` of the results: ``T_part_drf`` of every evaluated
-    DRF (named ``<DRF> T_part_drf``) and the part's placement ``T_fixture_part``.
+    frame (named ``<id> T_part_drf``; a best fit's too) and the part's placement
+    ``T_fixture_part``.
 
     The schema's key for ``DRFTransformActualId`` collects only the document's top-level
-    ``<Transforms>``, so each DRF transform is also written there (``top``, its own id, same
-    name and matrix); returns DRF name -> that id, for the characteristic measurements."""
+    ``<Transforms>``, so each DRF's transform is also written there (``top``, its own id, same
+    name and matrix); returns DRF name -> that id, for the characteristic measurements (a best
+    fit is no DRF and is not referenced)."""
     out: dict[str, int] = {}
     for fr in frames:
         if fr.get("status") == "evaluated" and fr.get("T_part_drf"):
             T = pose_matrix(fr["T_part_drf"], f"DRF {fr['id']} T_part_drf")
             _transform(lst, T, f"{fr['id']} T_part_drf", ids)
-            out[fr["id"]] = _transform(top, T, f"{fr['id']} T_part_drf", ids)
+            if fr.get("datums"):
+                out[fr["id"]] = _transform(top, T, f"{fr['id']} T_part_drf", ids)
     if placement and placement.get("T_fixture_part"):
         T = pose_matrix(placement["T_fixture_part"], "placement T_fixture_part")
         _transform(lst, T, "placement T_fixture_part", ids)

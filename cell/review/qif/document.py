@@ -122,7 +122,8 @@ def build_qif(
     top_transforms = counted(root, "Transforms")
     drf_ids = reference_frames(root, frames, datums, datum_ids, ids)
     root.append(feats_holder[0])
-    item_ids = characteristic_section(root, chars, features, drf_ids, std_id, ids)
+    other_frames = {"fixture"} | {fr["id"] for fr in frames if not fr.get("datums")}
+    item_ids = characteristic_section(root, chars, features, drf_ids, std_id, ids, other_frames)
     mr = sub(
         counted(sub(root, "Results"), "MeasurementResultsSet"),
         "MeasurementResults",
