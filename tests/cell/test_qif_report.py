@@ -196,3 +196,13 @@ def test_a_best_fit_and_the_fixture_frame_are_no_drf(tmp_path: Path) -> None:
     report["characteristics"][1]["drf"] = "DRF9"
     with pytest.raises(QifError, match=r"H1\.position: unknown DRF 'DRF9'"):
         write_qif(report, tmp_path / "r.qif", NORMALS)
+
+
+def test_a_run_without_a_readable_cell_file_names_it() -> None:
+    from cell.errors import ConfigError
+    from cell.review.qif.run_file import hole_axes
+
+    with pytest.raises(ConfigError, match=r"^runs/r1 \(cell\): robot: the run's cell file: "):
+        hole_axes({"cell_text": "name: c\n", "cell_path": ""}, "runs/r1 (cell)")
+    with pytest.raises(ConfigError, match=r"\(yaml\): the run's cell file: "):
+        hole_axes({"cell_text": "a: [\n", "cell_path": ""}, "runs/r1 (cell)")
