@@ -206,3 +206,20 @@ def test_a_run_without_a_readable_cell_file_names_it() -> None:
         hole_axes({"cell_text": "name: c\n", "cell_path": ""}, "runs/r1 (cell)")
     with pytest.raises(ConfigError, match=r"\(yaml\): the run's cell file: "):
         hole_axes({"cell_text": "a: [\n", "cell_path": ""}, "runs/r1 (cell)")
+
+
+def test_the_reader_converts_a_community_sample_from_mm(tmp_path: Path) -> None:
+    got = read_qif(SCHEMA_DIR / "samples" / "testPython30.qif")
+    by = {c.name: c for c in got.characteristics}
+    assert by["DIAM1_B"].value_m == pytest.approx(0.012699)
+    assert (by["DIAM1_B"].lsl_m, by["DIAM1_B"].usl_m) == pytest.approx((0.0124, 0.0130))
+    assert (by["DIAM2"].lsl_m, by["DIAM2"].usl_m) == pytest.approx((0.0063, 0.0065))  # limits
+    assert by["DIAM2"].status == "FAIL" and by["POSN1"].zone_m == pytest.approx(0.0005)
+    assert got.features["CIRC1"][1] == pytest.approx(0.0062)
+    text = (SCHEMA_DIR / "samples" / "testPython30.qif").read_text()
+    other = tmp_path / "feet.qif"
+    other.write_text(
+        text.replace("<SIUnitName>meter</SIUnitName>", "<SIUnitName>foot</SIUnitName>")
+    )
+    with pytest.raises(QifError, match=r"feet\.qif: line \d+: .*SIUnitName.*'foot'"):
+        read_qif(other)

@@ -69,9 +69,7 @@ def read_runs(paths: Sequence[str | Path]) -> list[QifResults]:
 
 
 def _limits(c: CharacteristicResult) -> tuple[float | None, float | None]:
-    if c.kind == "diameter":
-        return c.nominal_m + c.lower_m, c.nominal_m + c.upper_m
-    return None, c.zone_m
+    return c.lsl_m, c.usl_m
 
 
 def series(runs: Sequence[QifResults]) -> list[Series]:
