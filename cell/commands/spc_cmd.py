@@ -18,7 +18,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Reads the report.qif of every RUN_DIR (or of every run folder inside a folder "
             "given), validated against the QIF 3.0 schemas, and writes OUT/spc.csv (per "
             "characteristic: n, mean, overall s, moving-range sigma MR-bar/1.128, control "
-            "limits, tolerance limits, Cp, Cpk, Pp, Ppk, runs out of control; SI units) and "
+            "limits, tolerance limits, Cp, Cpk, Pp, Ppk, for positions the percentile Cpk of a "
+            "Rice fit, runs out of control; SI units) and "
             "OUT/spc.html (the same table with individuals and moving-range charts)."
         ),
     )
