@@ -113,13 +113,8 @@ def _table(results: list[Analysis]) -> str:
         digits = 1 if s.kind == "position" else 4
         n = sum(p.value_m is not None for p in s.points)
         if cap is None:
-            cells = [
-                escape(s.name),
-                s.kind,
-                u,
-                str(n),
-                f'<span class="note">{escape(why)}</span>',
-            ] + [""] * 10
+            note = f'<td class="l note" colspan="11">{escape(why)}</td>'
+            cells = [escape(s.name), s.kind, u, str(n)]
             nooc = 0
         else:
             ooc = _ooc_runs(s, cap)
@@ -145,7 +140,7 @@ def _table(results: list[Analysis]) -> str:
             ]
         tds = "".join(
             f"<td{' class=l' if i in (0, 1, 14) else ''}>{c}</td>" for i, c in enumerate(cells)
-        )
+        ) + (note if cap is None else "")
         rows.append(f'<tr class="char" data-char="{escape(s.name)}" data-ooc="{nooc}">{tds}</tr>')
     ths = "".join(f"<th>{escape(h)}</th>" for h in head)
     return f'<table id="spc"><tr>{ths}</tr>{"".join(rows)}</table>'
