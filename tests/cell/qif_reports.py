@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from cell.review.qif.features import HoleNominal
+
 #: (hole id, nominal centre m, axis, nominal diameter m)
 HOLES = (
     ("A1", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), 0.010),
@@ -17,7 +19,8 @@ HOLES = (
     ("H1", (0.1, 0.1, 0.0), (0.0, 0.0, 1.0), 0.008),
     ("H2", (0.15, 0.12, 0.01), (0.0, 0.6, 0.8), 0.006),
 )
-NORMALS = {h[0]: h[2] for h in HOLES}
+#: the cell file's holes, as the QIF writer takes them
+NOMINALS = {h[0]: HoleNominal(h[1], h[2], h[3]) for h in HOLES}
 
 
 def _hole_row(hid, nominal, diameter, measured, dia, U_pos, U_dia) -> dict[str, Any]:

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from cell_fixtures import SmallCell
 from lxml import etree
-from qif_reports import NORMALS, gdt_report
+from qif_reports import NOMINALS, gdt_report
 from scipy.spatial.transform import Rotation
 from test_cell_report_html import _result
 
@@ -60,7 +60,7 @@ def _T(pose: dict) -> np.ndarray:
 
 def test_a_gdt_report_round_trips_through_qif(tmp_path: Path) -> None:
     report = gdt_report(np.random.default_rng(3))
-    path = write_qif(report, tmp_path / "report.qif", NORMALS)
+    path = write_qif(report, tmp_path / "report.qif", NOMINALS)
     got = read_qif(path)
     chars = {c["id"]: c for c in report["characteristics"]}
     assert [c.name for c in got.characteristics] == list(chars)
@@ -103,7 +103,7 @@ def test_a_gdt_report_round_trips_through_qif(tmp_path: Path) -> None:
 
 
 def test_qif_sections_name_datums_frames_and_features(tmp_path: Path) -> None:
-    root = build_qif(gdt_report(np.random.default_rng(1)), NORMALS)
+    root = build_qif(gdt_report(np.random.default_rng(1)), NOMINALS)
     q = "{http://qifstandards.org/xsd/qif3}"
     labels = [e.text for e in root.iter(q + "DatumLabel")]
     assert labels == ["A", "B", "C"]
@@ -136,16 +136,16 @@ def test_bad_reports_are_refused_with_the_field_named(tmp_path: Path) -> None:
     report = gdt_report(np.random.default_rng(2))
     report["datums"][1]["holes"] = ["NOPE"]
     with pytest.raises(QifError, match=r"datum B: unknown hole\(s\) \['NOPE'\]"):
-        write_qif(report, tmp_path / "r.qif", NORMALS)
+        write_qif(report, tmp_path / "r.qif", NOMINALS)
     report = gdt_report(np.random.default_rng(2))
     report["characteristics"][0]["decision"] = "fine"
     with pytest.raises(QifError, match="decision 'fine'"):
-        write_qif(report, tmp_path / "r.qif", NORMALS)
-    with pytest.raises(QifError, match="hole 'H1': no nominal axis"):
+        write_qif(report, tmp_path / "r.qif", NOMINALS)
+    with pytest.raises(QifError, match="hole 'H1' is not in the run's cell file"):
         write_qif(
             gdt_report(np.random.default_rng(2)),
             tmp_path / "r.qif",
-            {k: v for k, v in NORMALS.items() if k != "H1"},
+            {k: v for k, v in NOMINALS.items() if k != "H1"},
         )
     assert not (tmp_path / "r.qif").exists()
 
@@ -174,7 +174,8 @@ def test_every_run_writes_a_valid_report_qif_equal_to_report_json(
     assert got.inspection_status == inspection_status(want_chars)
     tree = etree.parse(str(tmp_path / "report.qif"))
     nominal = tree.getroot().findall(".//{*}CircleFeatureNominal")
-    assert len(nominal) == len(doc["holes"])
+    assert len(nominal) == len(small_cell.cell.part.holes) == 3  # the unreached hole too
+    assert len(doc["holes"]) == 2
 
 
 def test_a_best_fit_and_the_fixture_frame_are_no_drf(tmp_path: Path) -> None:
@@ -186,7 +187,7 @@ def test_a_best_fit_and_the_fixture_frame_are_no_drf(tmp_path: Path) -> None:
     for c in report["characteristics"]:
         if c["kind"] == "position":
             c["drf"], c["datums"] = ("ALIGN", []) if c["hole_id"] == "H1" else ("fixture", [])
-    got = read_qif(write_qif(report, tmp_path / "report.qif", NORMALS))
+    got = read_qif(write_qif(report, tmp_path / "report.qif", NOMINALS))
     assert {c.name for c in got.characteristics} >= {"H1.position", "H2.position"}
     assert all(c.drf_transform is None for c in got.characteristics)
     assert "ALIGN T_part_drf" in got.transforms
@@ -195,17 +196,17 @@ def test_a_best_fit_and_the_fixture_frame_are_no_drf(tmp_path: Path) -> None:
     assert root.find(".//{*}PositionCharacteristicDefinition/{*}DatumReferenceFrameId") is None
     report["characteristics"][1]["drf"] = "DRF9"
     with pytest.raises(QifError, match=r"H1\.position: unknown DRF 'DRF9'"):
-        write_qif(report, tmp_path / "r.qif", NORMALS)
+        write_qif(report, tmp_path / "r.qif", NOMINALS)
 
 
 def test_a_run_without_a_readable_cell_file_names_it() -> None:
     from cell.errors import ConfigError
-    from cell.review.qif.run_file import hole_axes
+    from cell.review.qif.run_file import hole_nominals
 
     with pytest.raises(ConfigError, match=r"^runs/r1 \(cell\): robot: the run's cell file: "):
-        hole_axes({"cell_text": "name: c\n", "cell_path": ""}, "runs/r1 (cell)")
+        hole_nominals({"cell_text": "name: c\n", "cell_path": ""}, "runs/r1 (cell)")
     with pytest.raises(ConfigError, match=r"\(yaml\): the run's cell file: "):
-        hole_axes({"cell_text": "a: [\n", "cell_path": ""}, "runs/r1 (cell)")
+        hole_nominals({"cell_text": "a: [\n", "cell_path": ""}, "runs/r1 (cell)")
 
 
 def test_the_reader_converts_a_community_sample_from_mm(tmp_path: Path) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from qif_reports import NORMALS, gdt_report
+from qif_reports import NOMINALS, gdt_report
 
 from cell.cli import main
 from cell.review.qif import write_qif
@@ -29,7 +29,7 @@ def _runs(root: Path, n: int, seed: int = 11, **kw) -> Path:
         extra = {k: (v(i) if callable(v) else v) for k, v in kw.items()}
         d = root / f"run{i:03d}"
         d.mkdir(parents=True)
-        write_qif(gdt_report(rng, 1.8e9 + 60.0 * i, **extra), d / "report.qif", NORMALS)
+        write_qif(gdt_report(rng, 1.8e9 + 60.0 * i, **extra), d / "report.qif", NOMINALS)
     return root
 
 

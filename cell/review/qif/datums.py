@@ -21,7 +21,7 @@ from lxml import etree
 from scipy.spatial.transform import Rotation
 
 from cell.review.qif.errors import QifError
-from cell.review.qif.features import FeatureIds, plane_feature, plane_through
+from cell.review.qif.features import FeatureIds, HoleNominal, plane_feature, plane_through
 from cell.review.qif.xmlutil import Ids, counted, ids_list, sub, vec
 
 PRECEDENCE = ("PRIMARY", "SECONDARY", "TERTIARY", "QUATERNARY", "QUINARY", "SENARY")
@@ -45,10 +45,9 @@ def pose_matrix(pose: Mapping[str, Any], what: str) -> np.ndarray:
 def datum_definitions(
     root: etree._Element,
     datums: Sequence[Mapping[str, Any]],
-    holes: Mapping[str, Mapping[str, Any]],
+    holes: Mapping[str, HoleNominal],
     features: Mapping[str, FeatureIds],
     feature_lists: tuple[etree._Element, ...],
-    normals: Mapping[str, Sequence[float]],
     ids: Ids,
 ) -> dict[str, int]:
     """``<DatumDefinitions>``; returns datum label -> its QIF id."""
@@ -62,7 +61,7 @@ def datum_definitions(
         if kind in ("hole", "pattern"):
             nominal_ids = [features[n].nominal for n in names]
         elif kind == "plane" and names:
-            point, normal = plane_through([holes[n] for n in names], normals)
+            point, normal = plane_through([holes[n] for n in names])
             f = plane_feature(*feature_lists, f"datum {label}", point, normal, ids)
             nominal_ids = [f.nominal]
         else:

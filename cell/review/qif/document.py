@@ -26,7 +26,13 @@ from lxml import etree
 
 from cell.review.qif.characteristics import characteristic_measurements, characteristic_section
 from cell.review.qif.datums import actual_transforms, datum_definitions, reference_frames
-from cell.review.qif.features import features_section, hole_features, measured_features
+from cell.review.qif.errors import QifError
+from cell.review.qif.features import (
+    HoleNominal,
+    features_section,
+    hole_features,
+    measured_features,
+)
 from cell.review.qif.validator import NS, validate_tree
 from cell.review.qif.xmlutil import Ids, counted, finish_counts, sub
 
@@ -98,27 +104,29 @@ def _prune(root: etree._Element) -> None:
 
 def build_qif(
     report: Mapping[str, Any],
-    nominal_normals: Mapping[str, Sequence[float]],
+    nominals: Mapping[str, HoleNominal],
     measured_normals: Mapping[str, Sequence[float]] | None = None,
 ) -> etree._Element:
     """The ``QIFDocument`` of a report.json mapping (``holes`` plus, when present, ``datums``,
-    ``datum_reference_frames``, ``placement`` and ``characteristics``). ``nominal_normals``:
-    hole id -> nominal axis (the cell file's ``normal``, part frame); ``measured_normals``:
-    hole id -> measured axis (part frame), for the measured features."""
+    ``datum_reference_frames``, ``placement`` and ``characteristics``). ``nominals``: hole id ->
+    the cell file's hole (part frame), every hole of the part; ``measured_normals``: hole id ->
+    measured axis (part frame), for the measured features."""
     ids = Ids()
     holes = list(report.get("holes") or [])
-    by_id = {h["hole_id"]: h for h in holes}
     datums = list(report.get("datums") or [])
     frames = list(report.get("datum_reference_frames") or [])
     chars = list(report.get("characteristics") or [])
+    unknown = [h["hole_id"] for h in holes if h["hole_id"] not in nominals]
+    if unknown:
+        raise QifError("report", [f"hole {unknown[0]!r} is not in the run's cell file"])
     root = etree.Element(f"{{{NS}}}QIFDocument", nsmap={None: NS}, versionQIF=QIF_VERSION)
     std_id = _header(root, report, ids)
     # the Features section comes after the datums in the file but datums refer to features:
     # build features detached, then place every section in the schema's order
     feats_holder = etree.Element("holder")
     lists = features_section(feats_holder)
-    features = hole_features(*lists, holes, nominal_normals, ids)
-    datum_ids = datum_definitions(root, datums, by_id, features, lists, nominal_normals, ids)
+    features = hole_features(*lists, nominals, ids)
+    datum_ids = datum_definitions(root, datums, nominals, features, lists, ids)
     top_transforms = counted(root, "Transforms")
     drf_ids = reference_frames(root, frames, datums, datum_ids, ids)
     root.append(feats_holder[0])
@@ -147,13 +155,13 @@ def build_qif(
 def write_qif(
     report: Mapping[str, Any],
     path: str | Path,
-    nominal_normals: Mapping[str, Sequence[float]],
+    nominals: Mapping[str, HoleNominal],
     measured_normals: Mapping[str, Sequence[float]] | None = None,
 ) -> Path:
     """Build, validate (raises :class:`~cell.review.qif.errors.QifError`) and write
     ``report.qif`` to ``path`` (atomically: a reader never sees half a file)."""
     path = Path(path)
-    root = build_qif(report, nominal_normals, measured_normals)
+    root = build_qif(report, nominals, measured_normals)
     validate_tree(root, str(path))
     tmp = path.with_name(path.name + ".tmp")
     etree.ElementTree(root).write(

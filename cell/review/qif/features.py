@@ -2,10 +2,11 @@
 
 Every hole is a ``Circle`` feature: the stereo head measures the rim where the hole meets the
 surface (its centre, its normal = the hole's axis, its diameter), which is what QIF's circle
-carries (``Location``, ``Normal``, ``Diameter``). Nominals and measurements are in the nominal
-part frame (``part.base``), in the file's units (m). A plane datum named by holes gets a
-``Plane`` feature whose nominal is the least-squares plane through those holes' nominal centres,
-its normal on the side of their nominal axes.
+carries (``Location``, ``Normal``, ``Diameter``). Every hole of the cell file is a feature
+(nominal and item), measured or not; a measured hole also gets a feature measurement.
+Nominals and measurements are in the nominal part frame (``part.base``), in metres. A plane
+datum named by holes gets a ``Plane`` feature whose nominal is the least-squares plane through
+those holes' nominal centres, its normal on the side of their nominal axes.
 """
 
 from __future__ import annotations
@@ -21,6 +22,16 @@ from cell.review.qif.errors import QifError
 from cell.review.qif.xmlutil import Ids, counted, dec, sub, vec
 
 
+@dataclass(frozen=True)
+class HoleNominal:
+    """A hole as the cell file gives it: centre (m) and unit axis in the part frame, diameter
+    (m)."""
+
+    position_m: Sequence[float]
+    normal: Sequence[float]
+    diameter_m: float
+
+
 @dataclass
 class FeatureIds:
     """The QIF ids of one feature: definition, nominal, item, measurement (0: none)."""
@@ -29,11 +40,6 @@ class FeatureIds:
     nominal: int
     item: int
     measurement: int = 0
-
-
-def nominal_centre(hole: Mapping[str, Any]) -> list[float]:
-    """A report row's nominal centre (m, part frame)."""
-    return [float(hole[f"nominal_{a}_m"]) for a in "xyz"]
 
 
 def measured_centre(hole: Mapping[str, Any]) -> list[float] | None:
@@ -51,16 +57,13 @@ def _unit(v: Sequence[float], what: str) -> np.ndarray:
     return a / n
 
 
-def plane_through(
-    holes: Sequence[Mapping[str, Any]], normals: Mapping[str, Sequence[float]]
-) -> tuple[np.ndarray, np.ndarray]:
+def plane_through(holes: Sequence[HoleNominal]) -> tuple[np.ndarray, np.ndarray]:
     """The least-squares plane through the holes' nominal centres: (point, unit normal), the
     normal on the side of the holes' mean nominal axis (for fewer than three holes: the point
     is their centroid and the normal their mean axis)."""
-    pts = np.array([nominal_centre(h) for h in holes])
+    pts = np.array([h.position_m for h in holes], float)
     mean_axis = _unit(
-        np.sum([_unit(normals[h["hole_id"]], h["hole_id"]) for h in holes], 0),
-        "mean axis of the plane's holes",
+        np.sum([_unit(h.normal, "hole axis") for h in holes], 0), "mean axis of the plane's holes"
     )
     centroid = pts.mean(axis=0)
     if len(pts) < 3:
@@ -74,24 +77,21 @@ def hole_features(
     definitions: etree._Element,
     nominals: etree._Element,
     items: etree._Element,
-    holes: Sequence[Mapping[str, Any]],
-    normals: Mapping[str, Sequence[float]],
+    holes: Mapping[str, HoleNominal],
     ids: Ids,
 ) -> dict[str, FeatureIds]:
-    """A circle definition, nominal and item per hole (internal, at the nominal diameter)."""
+    """A circle definition, nominal and item per hole of the cell file (internal, at the
+    nominal diameter), measured or not."""
     out: dict[str, FeatureIds] = {}
-    for h in holes:
-        hid = h["hole_id"]
-        if hid not in normals:
-            raise QifError("report", [f"hole {hid!r}: no nominal axis in the cell file"])
+    for hid, h in holes.items():
         f = FeatureIds(ids.next(), ids.next(), ids.next())
         d = sub(definitions, "CircleFeatureDefinition", id=str(f.definition))
         sub(d, "InternalExternal", "INTERNAL")
-        sub(d, "Diameter", dec(h["nominal_diameter_m"]))
+        sub(d, "Diameter", dec(h.diameter_m))
         n = sub(nominals, "CircleFeatureNominal", id=str(f.nominal))
         sub(n, "FeatureDefinitionId", str(f.definition))
-        sub(n, "Location", vec(nominal_centre(h)))
-        sub(n, "Normal", vec(_unit(normals[hid], f"hole {hid!r} axis")))
+        sub(n, "Location", vec(h.position_m))
+        sub(n, "Normal", vec(_unit(h.normal, f"hole {hid!r} axis")))
         it = sub(items, "CircleFeatureItem", id=str(f.item))
         sub(it, "FeatureNominalId", str(f.nominal))
         sub(it, "FeatureName", hid)

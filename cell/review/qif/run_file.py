@@ -12,12 +12,13 @@ from pydantic import ValidationError
 from cell.config import CellConfig, parse_cell
 from cell.errors import ConfigError
 from cell.review.qif.document import write_qif
+from cell.review.qif.features import HoleNominal
 from cell.run.results import HoleResult
 
 
-def hole_axes(info: Mapping[str, Any], where: str) -> dict[str, Sequence[float]]:
-    """Hole id -> nominal axis (part frame) from the cell file stored with the run (``info``:
-    the store's run row). Only the schema is checked (the run checked the rest when it
+def hole_nominals(info: Mapping[str, Any], where: str) -> dict[str, HoleNominal]:
+    """Hole id -> the hole (part frame) from the cell file stored with the run (``info``: the
+    store's run row). Only the schema is checked (the run checked the rest when it
     started, and a mesh moved since must not stop a report); a holes CSV is read again."""
     try:
         cfg = CellConfig.model_validate(yaml.safe_load(info["cell_text"]))
@@ -31,7 +32,7 @@ def hole_axes(info: Mapping[str, Any], where: str) -> dict[str, Sequence[float]]
     if cfg.part.holes_csv is not None:
         path = Path(info["cell_path"]) if info.get("cell_path") else None
         cfg = parse_cell(info["cell_text"], where, path)
-    return {h.id: h.normal for h in cfg.part.holes}
+    return {h.id: HoleNominal(h.position, h.normal, h.diameter) for h in cfg.part.holes}
 
 
 def write_run_qif(
@@ -40,8 +41,9 @@ def write_run_qif(
     info: Mapping[str, Any],
     results: Sequence[HoleResult],
 ) -> Path:
-    """Write ``run_dir/report.qif`` from the report.json mapping ``report``; the nominal axes
-    come from the cell file stored with the run, the measured axes from the hole results."""
-    nominal = hole_axes(info, f"{run_dir} (cell)")
+    """Write ``run_dir/report.qif`` from the report.json mapping ``report``; the holes' nominals
+    come from the cell file stored with the run (report.json has no axes, and lists the stored
+    holes only), the measured axes from the hole results."""
+    nominal = hole_nominals(info, f"{run_dir} (cell)")
     measured = {r.hole_id: r.normal_part for r in results if r.normal_part is not None}
     return write_qif(report, Path(run_dir) / "report.qif", nominal, measured)
