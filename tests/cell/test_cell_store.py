@@ -17,12 +17,15 @@ from cell.run.results import HoleResult
 
 
 def _cell_text() -> str:
-    """The built-in cell with its first two holes named H1 and H2 (report.qif reads the holes'
-    nominal axes from the run's cell file)."""
+    """The built-in cell with its first two holes named H1 and H2 and no datums or tolerances
+    (report.qif reads the holes' nominals from the run's cell file)."""
     data = yaml.safe_load(builtin_cell_path().read_text())
     data["part"]["holes"] = data["part"]["holes"][:2]
+    for key in ("datums", "alignment"):  # datums name holes this cell no longer has
+        data["part"].pop(key, None)
     for hole, name in zip(data["part"]["holes"], ("H1", "H2"), strict=True):
         hole["id"] = name
+        hole.pop("tolerances", None)
     return yaml.safe_dump(data, sort_keys=False)
 
 
