@@ -17,7 +17,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "(summary, every hole, every event; SI units) and RUN_DIR/report.csv (one row per "
             "hole: nominal and measured centre, deviation, diameter, pass, uncertainty) and "
             "RUN_DIR/report.html (the inspection protocol: header, hole table with U and the "
-            "ISO 14253-1 decision, plots; self-contained)."
+            "ISO 14253-1 decision, plots; self-contained) and RUN_DIR/report.qif (QIF 3.0 "
+            "results, validated against the vendored QIF schemas; docs/qif.md)."
         ),
     )
     p.add_argument("run_dir", help="a run directory (holds results.sqlite)")
@@ -29,5 +30,5 @@ def run_report(args: argparse.Namespace) -> int:
     """Handler of ``holecell report``."""
     summ = write_report(args.run_dir, args.operator)
     print(format_summary(summ))
-    print(f"wrote {args.run_dir}/report.json, report.csv and report.html")
+    print(f"wrote {args.run_dir}/report.json, report.csv, report.qif and report.html")
     return 0

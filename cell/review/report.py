@@ -22,6 +22,7 @@ from typing import Any
 
 from cell.gdt.html import gdt_section
 from cell.gdt.report_fields import report_evaluation
+from cell.review.qif.run_file import write_run_qif
 from cell.review.report_html import render_html
 from cell.review.store import Store
 from cell.run.results import HoleResult
@@ -120,7 +121,8 @@ def _components(r: HoleResult) -> dict[str, Any]:
 
 
 def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
-    """Write ``report.json``, ``report.csv`` and ``report.html`` (the inspection protocol,
+    """Write ``report.json``, ``report.csv``, ``report.qif`` (QIF 3.0, :mod:`cell.review.qif`)
+    and ``report.html`` (the inspection protocol,
     :mod:`cell.review.report_html`; ``operator`` fills its operator field) into ``run_dir``;
     returns the summary."""
     run_dir = Path(run_dir)
@@ -143,6 +145,7 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
         w.writeheader()
         for row in rows:
             w.writerow({k: ("" if v is None else v) for k, v in row.items()})
+    write_run_qif(doc, run_dir, info, results)  # QIF 3.0 results (cell.review.qif)
     return summ
 
 

@@ -8,15 +8,30 @@ import json
 from pathlib import Path
 
 import pytest
+import yaml
 
+from cell.config import builtin_cell_path
 from cell.review.report import write_report
 from cell.review.store import Store, StoreError
 from cell.run.results import HoleResult
 
 
+def _cell_text() -> str:
+    """The built-in cell with its first two holes named H1 and H2 and no datums or tolerances
+    (report.qif reads the holes' nominals from the run's cell file)."""
+    data = yaml.safe_load(builtin_cell_path().read_text())
+    data["part"]["holes"] = data["part"]["holes"][:2]
+    for key in ("datums", "alignment"):  # datums name holes this cell no longer has
+        data["part"].pop(key, None)
+    for hole, name in zip(data["part"]["holes"], ("H1", "H2"), strict=True):
+        hole["id"] = name
+        hole.pop("tolerances", None)
+    return yaml.safe_dump(data, sort_keys=False)
+
+
 def _store(tmp_path: Path) -> Store:
     holes = [("H1", 0, {"d": 0.01}), ("H2", 1, {"d": 0.01})]
-    return Store.create(tmp_path, cell_name="c", cell_sha256="abc", cell_text="name: c\n",
+    return Store.create(tmp_path, cell_name="c", cell_sha256="abc", cell_text=_cell_text(),
                         cell_path="", tour_text="{}", reference_text="", robot_model="m",
                         port="/dev/null", holes=holes)  # fmt: skip
 
@@ -101,6 +116,7 @@ def test_report_files(tmp_path: Path) -> None:
     rows = list(csv.DictReader((tmp_path / "report.csv").open()))
     assert rows[0]["pass"] == "True" and rows[1]["measured_x_m"] == ""
     assert float(rows[0]["measured_z_m"]) == pytest.approx(0.30001)
+    assert (tmp_path / "report.qif").is_file()
 
 
 def test_failed_creation_leaves_no_store(tmp_path: Path) -> None:

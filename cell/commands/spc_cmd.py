@@ -1,0 +1,55 @@
+"""``holecell spc RUN_DIR...``: SPC across runs (spc.csv, spc.html) from their report.qif."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from cell.review.spc.collect import read_runs, series
+from cell.review.spc.write import analyse, write_spc
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``spc``."""
+    p = sub.add_parser(
+        "spc",
+        help="statistics across runs: I-MR charts and Cp/Cpk per characteristic",
+        description=(
+            "Reads the report.qif of every RUN_DIR (or of every run folder inside a folder "
+            "given), validated against the QIF 3.0 schemas, and writes OUT/spc.csv (per "
+            "characteristic: n, mean, overall s, moving-range sigma MR-bar/1.128, control "
+            "limits, tolerance limits, Cp, Cpk, Pp, Ppk, for positions the percentile Cpk of a "
+            "Rice fit, runs out of control; SI units) and "
+            "OUT/spc.html (the same table with individuals and moving-range charts)."
+        ),
+    )
+    p.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directories or folders")
+    p.add_argument(
+        "--out",
+        default=None,
+        help="output folder (default: the one RUN_DIR or folder given; else .)",
+    )
+    p.set_defaults(handler=run_spc)
+
+
+def run_spc(args: argparse.Namespace) -> int:
+    """Handler of ``holecell spc``."""
+    runs = read_runs(args.run_dirs)
+    results = analyse(series(runs))
+    out = args.out or (args.run_dirs[0] if len(args.run_dirs) == 1 else ".")
+    csv_path, html_path = write_spc(results, [str(Path(r.path).parent) for r in runs], out)
+    print(f"{len(runs)} runs, {len(results)} characteristics")
+    if not results:
+        print("  (the runs' report.qif carry no characteristics: no drawing tolerances evaluated)")
+    for a in results:
+        s, cap = a.series, a.cap
+        if cap is None:
+            print(f"  {s.name:<22} {a.why}")
+        else:
+            cpk = "-" if cap.cpk is None else f"{cap.cpk:.2f}"
+            print(
+                f"  {s.name:<22} n {cap.n:3d}  Cpk {cpk:>6}  out of control "
+                f"{len(cap.out_of_control)}"
+            )
+    print(f"wrote {csv_path} and {html_path}")
+    return 0
