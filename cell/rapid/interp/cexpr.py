@@ -142,13 +142,12 @@ class ExprCompiler:
     def _rel(self, node) -> Expr:
         op = str(node.children[1])
         a, b, t = self._numeric_pair(node)
-        if t.name == "?":
-            if (
-                a.type != b.type
-                or base(a.type.name) not in ("bool", "string")
-                or op not in ("=", "<>")
-            ):
-                raise self.err(f"cannot compare {a.type} {op} {b.type}", node)
+        if t.name == "?" and (
+            a.type != b.type
+            or base(a.type.name) not in ("bool", "string")
+            or op not in ("=", "<>")
+        ):
+            raise self.err(f"cannot compare {a.type} {op} {b.type}", node)
         fa, fb = a.fn, b.fn
         f = {"=": lambda fr: bool(fa(fr) == fb(fr)), "<>": lambda fr: bool(fa(fr) != fb(fr)),
              "<": lambda fr: bool(fa(fr) < fb(fr)), ">": lambda fr: bool(fa(fr) > fb(fr)),
@@ -282,7 +281,7 @@ class ExprCompiler:
     def _select_loc(self, loc, t: Type, sel):
         line = line_of(sel)
         if sel.data == "index":
-            get, et = self._select(lambda fr: (lambda ck: ck[0][ck[1]])(loc(fr)), t, sel)
+            _get, et = self._select(lambda fr: (lambda ck: ck[0][ck[1]])(loc(fr)), t, sel)
             idx = [self.expr(c, NUM).fn for c in sel.children]
 
             def at(fr):

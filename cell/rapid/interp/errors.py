@@ -35,5 +35,5 @@ class RapidRunError(RapidError):
         super().__init__(f"{name}: {text}", line)
 
 
-class RapidStopped(RapidError):
+class RapidStopped(RapidError):  # noqa: N818 (RAPID: "execution stopped")
     """Program execution stopped: an error no handler took, or a routine without RETURN."""
