@@ -5,9 +5,14 @@ MODULE HolecellLink
   ! (cell.link.frame, cell.link.messages); tests/cell/test_cell_rapid.py checks
   ! that they are equal and that the CRC-32 routine reproduces zlib.crc32.
   !
-  ! Runs in the motion task: PROC hcMain. Needs RobotWare 6 (dnum bit functions),
-  ! the serial channel configured as "com1:" (115200 8N1, no flow control) and
-  ! six analog inputs aiTempJ1 .. aiTempJ6 (link temperatures, degC).
+  ! Runs in the motion task: PROC hcMain. Needs RobotWare 6 (dnum bit functions)
+  ! or RobotWare 7, and six analog inputs aiTempJ1 .. aiTempJ6 (link
+  ! temperatures, degC). The link (HC_TRANSPORT below):
+  !   "serial": the serial channel configured as "com1:" (115200 8N1, no flow
+  !             control); IRC5 only (OmniCore has no serial channel for RAPID);
+  !   "socket": RAPID socket messaging, this controller a TCP server on
+  !             HC_SOCKET_ADDRESS:HC_SOCKET_PORT; IRC5 needs RobotWare option
+  !             616-1 PC Interface or 672-1 Socket Messaging; RobotWare 7 has it.
   ! Units on the wire: joints int32 micro-degrees, temperatures int32 milli-degC.
   !*****************************************************************************
 
@@ -66,8 +71,23 @@ MODULE HolecellLink
   CONST num HC_ON_PATH_TOL_DEG := 0.001;
   CONST num HC_N_TEMPS := 6;
 
+  ! --- transport: "serial" (the channel HC_PORT) or "socket" (RAPID socket
+  ! messaging, this controller the server on HC_SOCKET_ADDRESS:HC_SOCKET_PORT).
+  ! Serial needs a configured serial channel; socket needs option 616-1 PC
+  ! Interface or 672-1 Socket Messaging on IRC5 (RobotWare 6), and is part of
+  ! RobotWare 7 (OmniCore). Only hcLinkOpen, hcLinkRead and hcLinkWrite differ.
+  CONST string HC_TRANSPORT := "serial";
+  CONST string HC_SOCKET_ADDRESS := "192.168.125.1";
+  CONST num HC_SOCKET_PORT := 1025;
+  CONST num HC_POLL_S := 0.002;
+
   VAR iodev hcChan;
+  VAR socketdev hcServer;
+  VAR socketdev hcClient;
+  VAR bool hcConnected := FALSE;
+  VAR rawbytes hcRxChunk;
   VAR clock hcClock;
+  VAR clock hcLinkClock;
   VAR dnum hcCrcTable{256};
   ! receive state machine
   VAR num hcRxState := 0;
@@ -83,8 +103,9 @@ MODULE HolecellLink
   VAR dnum hcLastCrc := 0;
   VAR rawbytes hcLastAnswer;
   VAR rawbytes hcAns;
-  VAR num hcLastRx := 0;
-  ! trajectory (degrees) and motion state
+  ! trajectory: rows as received (int32 micro-degrees, exact in dnum) and in
+  ! degrees (num, for the motion), stop rows (1-based), motion state
+  VAR dnum hcRowsUdeg{HC_MAX_ROWS, 6};
   VAR num hcRows{HC_MAX_ROWS, 6};
   VAR num hcStops{HC_MAX_STOPS};
   VAR num hcNRows := 0;
@@ -112,18 +133,15 @@ MODULE HolecellLink
   ENDPROC
 
   PROC hcInit()
-    Close hcChan;
-    Open HC_PORT, hcChan \Bin;
-    ClearIOBuff hcChan;
+    hcLinkOpen;
     hcCrcInit;
     ClkReset hcClock;
     ClkStart hcClock;
-    AliasIO "aiTempJ1", hcTemp{1};
-    AliasIO "aiTempJ2", hcTemp{2};
-    AliasIO "aiTempJ3", hcTemp{3};
-    AliasIO "aiTempJ4", hcTemp{4};
-    AliasIO "aiTempJ5", hcTemp{5};
-    AliasIO "aiTempJ6", hcTemp{6};
+    ClkReset hcLinkClock;
+    ClkStart hcLinkClock;
+    FOR i FROM 1 TO HC_N_TEMPS DO
+      AliasIO "aiTempJ" + NumToStr(i, 0), hcTemp{i};
+    ENDFOR
     IF hcEstopLatched THEN
       hcState := ST_ESTOP;
       hcFault := FLT_ESTOP;
@@ -156,6 +174,8 @@ MODULE HolecellLink
     VAR num b;
     VAR dnum c;
     c := crc;
+    ! a FOR without STEP counts down when FROM > TO: no loop for count 0
+    IF count < 1 RETURN c;
     FOR i FROM first TO first + count - 1 DO
       UnpackRawBytes raw, i, b \IntX:=USINT;
       c := hcCrcByte(c, b);
@@ -163,27 +183,80 @@ MODULE HolecellLink
     RETURN c;
   ENDFUNC
 
+  ! --- transport ---------------------------------------------------------------
+  PROC hcLinkOpen()
+    IF HC_TRANSPORT = "socket" THEN
+      SocketClose hcClient;
+      SocketClose hcServer;
+      hcConnected := FALSE;
+      SocketCreate hcServer;
+      SocketBind hcServer, HC_SOCKET_ADDRESS, HC_SOCKET_PORT;
+      SocketListen hcServer;
+    ELSE
+      Close hcChan;
+      Open HC_PORT, hcChan \Bin;
+      ClearIOBuff hcChan;
+    ENDIF
+  ENDPROC
+
+  ! The bytes that arrive within HC_POLL_S, in hcRxChunk; their number (0: none).
+  ! A socket client is accepted first; a closed one is dropped (the watchdog
+  ! stops the arm) and the next one accepted.
+  FUNC num hcLinkRead()
+    ClearRawBytes hcRxChunk;
+    IF HC_TRANSPORT = "socket" THEN
+      IF NOT hcConnected THEN
+        SocketAccept hcServer, hcClient \Time:=HC_POLL_S;
+        hcConnected := TRUE;
+        hcRxState := 0;
+      ENDIF
+      SocketReceive hcClient \RawData:=hcRxChunk \Time:=HC_POLL_S;
+    ELSE
+      PackRawBytes ReadBin(hcChan \Time:=HC_POLL_S), hcRxChunk, 1 \IntX:=USINT;
+    ENDIF
+    RETURN RawBytesLen(hcRxChunk);
+  ERROR
+    IF ERRNO = ERR_DEV_MAXTIME OR ERRNO = ERR_SOCK_TIMEOUT THEN
+      RETURN 0;
+    ELSEIF ERRNO = ERR_SOCK_CLOSED THEN
+      SocketClose hcClient;
+      hcConnected := FALSE;
+      RETURN 0;
+    ENDIF
+    RAISE;
+  ENDFUNC
+
+  PROC hcLinkWrite(VAR rawbytes f)
+    IF HC_TRANSPORT = "socket" THEN
+      IF hcConnected SocketSend hcClient \RawData:=f;
+    ELSE
+      WriteRawBytes hcChan, f;
+    ENDIF
+  ERROR
+    IF ERRNO = ERR_SOCK_CLOSED THEN
+      SocketClose hcClient;
+      hcConnected := FALSE;
+      RETURN;
+    ENDIF
+    RAISE;
+  ENDPROC
+
   ! --- receiving ---------------------------------------------------------------
   ! Byte-wise state machine. Unlike the Python decoder it does not rescan the
   ! bytes of a rejected frame; a frame swallowed that way is recovered by the
   ! host's retransmission.
   PROC hcPollLine()
+    VAR num n;
     VAR num b;
-    b := hcReadByte();
-    WHILE b >= 0 DO
-      hcRxByte b;
-      b := hcReadByte();
+    n := hcLinkRead();
+    WHILE n > 0 DO
+      FOR i FROM 1 TO n DO
+        UnpackRawBytes hcRxChunk, i, b \IntX:=USINT;
+        hcRxByte b;
+      ENDFOR
+      n := hcLinkRead();
     ENDWHILE
   ENDPROC
-
-  FUNC num hcReadByte()
-    RETURN ReadBin(hcChan \Time:=0.002);
-  ERROR
-    IF ERRNO = ERR_DEV_MAXTIME THEN
-      RETURN -1;
-    ENDIF
-    RAISE;
-  ENDFUNC
 
   PROC hcRxByte(num b)
     TEST hcRxState
@@ -232,9 +305,9 @@ MODULE HolecellLink
       hcSendNak HC_SEQ_UNKNOWN, NAK_CRC, "bad CRC";
       RETURN;
     ENDIF
-    hcLastRx := ClkRead(hcClock);
+    ClkReset hcLinkClock;
     IF hcRxType <> MSG_IDENTIFY AND hcRxSeq = hcLastSeq AND crc = hcLastCrc THEN
-      WriteRawBytes hcChan, hcLastAnswer;
+      hcLinkWrite hcLastAnswer;
       RETURN;
     ENDIF
     hcLastSeq := hcRxSeq;
@@ -256,7 +329,7 @@ MODULE HolecellLink
     IF n > 0 CopyRawBytes pay, 1, f, 7 \NoOfBytes:=n;
     crc := BitXOrDnum(hcCrcRaw(HC_CRC32_INIT, f, 3, n + 4), HC_CRC32_INIT);
     PackRawBytes crc, f, n + 7 \IntX:=UDINT;
-    WriteRawBytes hcChan, f;
+    hcLinkWrite f;
     ClearRawBytes hcLastAnswer;
     CopyRawBytes f, 1, hcLastAnswer, 1;
   ENDPROC
@@ -329,13 +402,13 @@ MODULE HolecellLink
     PackRawBytes hcTargetStop, hcAns, 5 \IntX:=INT;
     PackRawBytes hcPos - 1, hcAns, 7 \IntX:=UDINT;
     PackRawBytes hcTrajId, hcAns, 11 \IntX:=UDINT;
-    PackRawBytes NumToDnum(Round(ClkRead(hcClock) * 1000) * 1000), hcAns, 15 \IntX:=LINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_1 * 1000000)), hcAns, 23 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_2 * 1000000)), hcAns, 27 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_3 * 1000000)), hcAns, 31 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_4 * 1000000)), hcAns, 35 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_5 * 1000000)), hcAns, 39 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_6 * 1000000)), hcAns, 43 \IntX:=DINT;
+    PackRawBytes NumToDnum(Round(ClkRead(hcClock) * 1000)) * 1000, hcAns, 15 \IntX:=LINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_1) * 1000000), hcAns, 23 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_2) * 1000000), hcAns, 27 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_3) * 1000000), hcAns, 31 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_4) * 1000000), hcAns, 35 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_5) * 1000000), hcAns, 39 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_6) * 1000000), hcAns, 43 \IntX:=DINT;
     PackRawBytes HC_N_TEMPS, hcAns, 47 \IntX:=USINT;
     FOR i FROM 1 TO HC_N_TEMPS DO
       PackRawBytes Round(AInput(hcTemp{i}) * 1000), hcAns, 44 + 4 * i \IntX:=DINT;
@@ -388,7 +461,8 @@ MODULE HolecellLink
     FOR r FROM 1 TO count DO
       FOR a FROM 1 TO 6 DO
         UnpackRawBytes hcRxPay, 6 + 24 * (r - 1) + 4 * (a - 1), v \IntX:=DINT;
-        hcRows{first + r, a} := DnumToNum(v) / 1000000;
+        hcRowsUdeg{first + r, a} := v;
+        hcRows{first + r, a} := DnumToNum(v / 1000000);
       ENDFOR
     ENDFOR
     hcAck;
@@ -430,29 +504,35 @@ MODULE HolecellLink
     hcLoaded := TRUE;
     hcPos := row;
     hcAtStop := -1;
-    FOR s FROM 1 TO hcNStops DO
-      IF hcStops{s} = row AND hcAtStop < 0 hcAtStop := s - 1;
-    ENDFOR
+    IF hcNStops > 0 THEN
+      FOR s FROM 1 TO hcNStops DO
+        IF hcStops{s} = row AND hcAtStop < 0 hcAtStop := s - 1;
+      ENDFOR
+    ENDIF
     hcState := ST_IDLE;
     IF hcAtStop >= 0 hcState := ST_IN_POSITION;
     hcAck;
   ENDPROC
 
-  ! CRC-32 of the rows (int32 LE micro-degrees) followed by the stop rows (u32 LE)
+  ! CRC-32 of the rows (int32 LE micro-degrees) followed by the stop rows (u32 LE).
+  ! From the received integers (dnum): a num keeps integers exact only up to
+  ! 8388608, so micro-degrees rebuilt from num degrees differ past 8.4 deg.
   FUNC dnum hcTrajectoryId()
     VAR rawbytes b;
     VAR dnum c;
     c := HC_CRC32_INIT;
     FOR r FROM 1 TO hcNRows DO
       FOR a FROM 1 TO 6 DO
-        PackRawBytes NumToDnum(Round(hcRows{r, a} * 1000000)), b, 1 \IntX:=DINT;
+        PackRawBytes hcRowsUdeg{r, a}, b, 1 \IntX:=DINT;
         c := hcCrcRaw(c, b, 1, 4);
       ENDFOR
     ENDFOR
-    FOR s FROM 1 TO hcNStops DO
-      PackRawBytes hcStops{s} - 1, b, 1 \IntX:=UDINT;
-      c := hcCrcRaw(c, b, 1, 4);
-    ENDFOR
+    IF hcNStops > 0 THEN
+      FOR s FROM 1 TO hcNStops DO
+        PackRawBytes hcStops{s} - 1, b, 1 \IntX:=UDINT;
+        c := hcCrcRaw(c, b, 1, 4);
+      ENDFOR
+    ENDIF
     c := BitXOrDnum(c, HC_CRC32_INIT);
     IF c = 0 c := 1;
     RETURN c;
@@ -558,7 +638,7 @@ MODULE HolecellLink
   ENDFUNC
 
   PROC hcWatchdog()
-    IF hcState = ST_MOVING AND ClkRead(hcClock) - hcLastRx > HC_LINK_TIMEOUT_S THEN
+    IF hcState = ST_MOVING AND ClkRead(hcLinkClock) > HC_LINK_TIMEOUT_S THEN
       hcHalt ST_STOPPED, FLT_LINK_LOST;
     ENDIF
   ENDPROC

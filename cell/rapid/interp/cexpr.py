@@ -35,6 +35,16 @@ class Expr:
         self.fn, self.type, self.lit = fn, type_, lit
 
 
+def constant(v):
+    """A closure returning ``v``, marked (``_const``) so callers may fold it."""
+
+    def fn(fr):
+        return v
+
+    fn._const = v
+    return fn
+
+
 def line_of(node) -> int:
     if isinstance(node, Token):
         return node.line or 0
@@ -60,7 +70,7 @@ class ExprCompiler:
     def coerce(self, e: Expr, want: Type, node) -> Expr:
         if e.lit is not None and base(want.name) in ("num", "dnum") and not want.ndim:
             v = F32(e.lit) if base(want.name) == "num" else float(e.lit)
-            return Expr(lambda fr, v=v: v, want)
+            return Expr(constant(v), want)
         if not assignable(want, e.type):
             raise self.err(f"type mismatch: {e.type} where {want} is expected", node)
         conv = converter(want, e.type)
@@ -221,7 +231,7 @@ class ExprCompiler:
         i = sym.slot
         if sym.kind == "const":
             v = sym.value
-            return (lambda fr: copy_value(v)) if isinstance(v, Record | Array) else (lambda fr: v)
+            return (lambda fr: copy_value(v)) if isinstance(v, Record | Array) else constant(v)
         if sym.is_global:
             g = self.state.globals
             return lambda fr: g[i]
@@ -242,6 +252,18 @@ class ExprCompiler:
             idx = [self.expr(c, NUM).fn for c in sel.children]
             if len(idx) != t.ndim:
                 raise self.err(f"{len(idx)} indices for an array of {t.ndim} dimensions", sel)
+
+            if len(idx) == 1:
+                (f0,) = idx
+
+                def at1(fr):
+                    a, i = get(fr), f0(fr)
+                    k = int(i)
+                    if k != i or not 0 < k <= a.dims[0]:
+                        a.offset([i], line)
+                    return a.v[k - 1]
+
+                return at1, t.elem
 
             def at(fr):
                 a = get(fr)

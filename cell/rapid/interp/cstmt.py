@@ -121,6 +121,14 @@ class StmtCompiler(ExprCompiler):
 
             return assign_s
 
+        if base(t.name) in _SCALARS and not t.ndim:
+
+            def assign_v(fr):
+                c, k = loc(fr)
+                c[k] = v(fr)
+
+            return assign_v
+
         def assign(fr):
             c, k = loc(fr)
             c[k] = copy_value(v(fr))
@@ -130,12 +138,7 @@ class StmtCompiler(ExprCompiler):
     def _s_call(self, node):
         args = node.children[1].children if len(node.children) > 1 else []
         e = self.call(node.children[0], args, node, function=False)
-        fn = e.fn
-
-        def run(fr):
-            fn(fr)
-
-        return run
+        return e.fn
 
     def _s_if_full(self, node):
         cond, *rest = node.children
@@ -312,7 +315,10 @@ class StmtCompiler(ExprCompiler):
         binders = []
         for p, a in zip(r.params, args, strict=True):
             if p.access == "in":
-                binders.append((p.slot, self.expr(a, p.type).fn))
+                f = self.expr(a, p.type).fn
+                if base(p.type.name) not in _SCALARS:
+                    f = (lambda g: lambda fr: copy_value(g(fr)))(f)
+                binders.append((p.slot, f))
                 continue
             if getattr(a, "data", None) != "ref":
                 raise self.err(f"argument {p.name} of {r.name} ({p.access.upper()}) must be "
@@ -326,7 +332,7 @@ class StmtCompiler(ExprCompiler):
         def invoke(fr):
             new = [None] * r.scope.n_slots
             for slot, f in binders:
-                new[slot] = copy_value(f(fr))
+                new[slot] = f(fr)
             for slot, init in r.locals_init:
                 new[slot] = init()
             try:
@@ -343,6 +349,7 @@ class StmtCompiler(ExprCompiler):
 
 
 _NO_VALUE = object()
+_SCALARS = ("num", "dnum", "bool", "string", "byte")
 _STMT_KINDS = {"assign", "call", "if_full", "if_compact", "while_", "for_", "test_", "return_",
                "raise_", "retry", "trynext", "exit_"}  # fmt: skip
 __all__ = ["Propagate", "Ret", "StmtCompiler", "assignable", "converter"]

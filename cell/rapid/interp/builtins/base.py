@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 
 from cell.rapid.interp.cexpr import Expr, line_of
 from cell.rapid.interp.rtypes import Type, assignable, base
@@ -102,23 +103,27 @@ class Builtin:
         return Expr(self._closure(c.state, line_of(node), [e.fn for e in req], optf), rtype)
 
     def _closure(self, st, line: int, req: list, optf: dict):
-        impl = self.impl
-        switches = {k: True for k, f in optf.items() if f is None}
-        valued = [(k, f) for k, f in optf.items() if f is not None]
-        if not valued and not switches:
+        static = {k: (True if f is None else f._const) for k, f in optf.items()
+                  if f is None or hasattr(f, "_const")}  # fmt: skip
+        valued = [(k, f) for k, f in optf.items() if k not in static]
+        impl = partial(self.impl, st, line, **static)
+        if not valued:
+            if len(req) == 0:
+                return lambda fr: impl()
             if len(req) == 1:
                 (a,) = req
-                return lambda fr: impl(st, line, a(fr))
+                return lambda fr: impl(a(fr))
             if len(req) == 2:
                 a, b = req
-                return lambda fr: impl(st, line, a(fr), b(fr))
-            return lambda fr: impl(st, line, *[f(fr) for f in req])
+                return lambda fr: impl(a(fr), b(fr))
+            if len(req) == 3:
+                a, b, c = req
+                return lambda fr: impl(a(fr), b(fr), c(fr))
+            return lambda fr: impl(*[f(fr) for f in req])
 
         def call(fr):
-            kw = dict(switches)
-            for k, f in valued:
-                kw[k] = f(fr)
-            return impl(st, line, *[f(fr) for f in req], **kw)
+            kw = {k: f(fr) for k, f in valued}
+            return impl(*[f(fr) for f in req], **kw)
 
         return call
 

@@ -1,5 +1,5 @@
 """Arithmetic, conversion and bit built-ins: Abs, Round, Trunc, Max, Min, Sqrt, NumToDnum,
-DnumToNum, BitAndDnum, BitOrDnum, BitXOrDnum, BitRShDnum, BitLShDnum, StrLen (RAPID reference
+DnumToNum, BitAndDnum, BitOrDnum, BitXOrDnum, BitRShDnum, BitLShDnum, NumToStr, StrLen (RAPID reference
 manual, "Functions"). num results are single precision, dnum results double."""
 
 from __future__ import annotations
@@ -78,7 +78,10 @@ def _steps(n, line: int) -> int:
 
 
 def _band(st, line, a, b):
-    return float(_u32(a, line) & _u32(b, line))
+    ia, ib = int(a), int(b)
+    if ia != a or ib != b or not (0 <= ia <= _U32 and 0 <= ib <= _U32):
+        _u32(a, line), _u32(b, line)
+    return float(ia & ib)
 
 
 def _bor(st, line, a, b):
@@ -86,15 +89,29 @@ def _bor(st, line, a, b):
 
 
 def _bxor(st, line, a, b):
-    return float(_u32(a, line) ^ _u32(b, line))
+    ia, ib = int(a), int(b)
+    if ia != a or ib != b or not (0 <= ia <= _U32 and 0 <= ib <= _U32):
+        _u32(a, line), _u32(b, line)
+    return float(ia ^ ib)
 
 
 def _brsh(st, line, a, n):
-    return float(_u32(a, line) >> _steps(n, line))
+    ia, k = int(a), int(n)
+    if ia != a or not 0 <= ia <= _U32 or k != n or not 1 <= k <= 32:
+        _u32(a, line), _steps(n, line)
+    return float(ia >> k)
 
 
 def _blsh(st, line, a, n):
     return float((_u32(a, line) << _steps(n, line)) & _U32)
+
+
+def _num_to_str(st, line, x, dec, exp=False):
+    d = int(dec)
+    if d != dec or not 0 <= d <= 15:
+        raise RapidRunError("ERR_ARGVALERR", f"Dec {float(dec):g}", line)
+    v = float(_round(st, line, float(x), float(d)))
+    return f"{v:.{d}e}" if exp else f"{v:.{d}f}"
 
 
 def _strlen(st, line, s):
@@ -126,6 +143,8 @@ BUILTINS = [
             ret="dnum", page="Functions: BitRShDnum"),
     Builtin("BitLShDnum", "func", (Arg("Value", ("dnum",)), Arg("ShiftSteps", ("num",))), _blsh,
             ret="dnum", page="Functions: BitLShDnum"),
+    Builtin("NumToStr", "func", (Arg("Val", _N), Arg("Dec", ("num",))), _num_to_str,
+            (Opt("Exp", after=2),), ret="string", page="Functions: NumToStr"),
     Builtin("StrLen", "func", (Arg("Str", ("string",)),), _strlen, ret="num",
             page="Functions: StrLen"),
 ]  # fmt: skip

@@ -46,6 +46,12 @@ def pack(
 ):
     c, k = ref
     raw: RawBytes = c[k]
+    if intx == 1 and isinstance(value, F32):
+        i = int(index)
+        if 0 <= value <= 255 and value == int(value) and i == index and 1 <= i <= RAWBYTES_MAX:
+            raw.data[i - 1] = int(value)
+            raw.n = max(raw.n, i)
+            return
     end = "<" if not network else ">"
     if intx is not None:
         if not isinstance(value, F32 | float):
@@ -91,6 +97,12 @@ def unpack(
 ):
     c, k = ref
     old = c[k]
+    if intx == 1 and isinstance(old, F32):
+        i = int(index)
+        if i != index or not 1 <= i <= raw.n:
+            _valid(raw, index, 1, line)
+        c[k] = F32(raw.data[i - 1])
+        return
     end = "<" if not network else ">"
     if intx is not None:
         code = _inttype(intx)
@@ -131,8 +143,9 @@ def clear(st, line, ref, fromindex=None):
     c, k = ref
     raw: RawBytes = c[k]
     start = 0 if fromindex is None else _start(raw, fromindex, 0)
-    raw.data[start:] = bytes(RAWBYTES_MAX - start)
-    raw.n = min(raw.n, start)
+    if raw.n > start:
+        raw.data[start : raw.n] = bytes(raw.n - start)
+        raw.n = start
 
 
 def copy(st, line, src: RawBytes, from_index, ref, to_index, noofbytes=None):
