@@ -38,6 +38,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
     p.add_argument("--transport", choices=("pty", "socket"), default="pty")
     p.add_argument(
+        "--controller",
+        choices=("python", "rapid"),
+        default="python",
+        help="python: the Python stand-in; rapid: the shipped RAPID module in the interpreter",
+    )
+    p.add_argument(
         "--speed", type=positive_float, default=1.0, help="simulation speed (x real time, > 0)"
     )
     p.add_argument(
@@ -81,7 +87,7 @@ def run_sim(args: argparse.Namespace) -> int:
         seed=args.seed,
     )
     world = WorldOptions(speed=args.speed, drift_offset_s=args.drift_offset_s, seed=args.seed)
-    with SimCell.start(cell, world, faults, args.transport) as sim:
+    with SimCell.start(cell, world, faults, args.transport, controller=args.controller) as sim:
         cam = CameraServer(sim.camera).start()
         try:
             print(f"controller  {sim.url}", flush=True)

@@ -69,6 +69,7 @@ MODULE HolecellLink
   CONST num HC_ROW_STEP := 10;
   CONST num HC_LINK_TIMEOUT_S := 1;
   CONST num HC_ON_PATH_TOL_DEG := 0.001;
+  CONST num HC_IN_POS_TOL_DEG := 0.001;
   CONST num HC_N_TEMPS := 6;
 
   ! --- transport: "serial" (the channel HC_PORT) or "socket" (RAPID socket
@@ -80,6 +81,9 @@ MODULE HolecellLink
   CONST string HC_SOCKET_ADDRESS := "192.168.125.1";
   CONST num HC_SOCKET_PORT := 1025;
   CONST num HC_POLL_S := 0.002;
+  ! longest wait for the rest of a frame on the serial channel (520 bytes take
+  ! 45 ms at 115200 baud); a frame cut short is dropped and retransmitted
+  CONST num HC_FRAME_S := 0.1;
 
   VAR iodev hcChan;
   VAR socketdev hcServer;
@@ -103,10 +107,14 @@ MODULE HolecellLink
   VAR dnum hcLastCrc := 0;
   VAR rawbytes hcLastAnswer;
   VAR rawbytes hcAns;
-  ! trajectory: rows as received (int32 micro-degrees, exact in dnum) and in
-  ! degrees (num, for the motion), stop rows (1-based), motion state
-  VAR dnum hcRowsUdeg{HC_MAX_ROWS, 6};
+  ! trajectory (degrees), stop rows (1-based), load progress and motion state.
+  ! The trajectory id is the CRC-32 of the rows and stops as they arrive on the
+  ! wire (int32/uint32): a num keeps integers exact only up to 8388608, so
+  ! micro-degrees rebuilt from num degrees would differ past 8.4 deg.
   VAR num hcRows{HC_MAX_ROWS, 6};
+  VAR num hcRowsIn := 0;
+  VAR num hcStopsIn := 0;
+  VAR dnum hcLoadCrc := 0;
   VAR num hcStops{HC_MAX_STOPS};
   VAR num hcNRows := 0;
   VAR num hcNStops := 0;
@@ -199,10 +207,12 @@ MODULE HolecellLink
     ENDIF
   ENDPROC
 
-  ! The bytes that arrive within HC_POLL_S, in hcRxChunk; their number (0: none).
+  ! Bytes received, in hcRxChunk; their number (0: none). Socket: what arrives
+  ! within HC_POLL_S; serial: one byte within HC_POLL_S, or the "want" bytes of
+  ! a frame's rest within HC_FRAME_S (else the frame is dropped).
   ! A socket client is accepted first; a closed one is dropped (the watchdog
   ! stops the arm) and the next one accepted.
-  FUNC num hcLinkRead()
+  FUNC num hcLinkRead(num want)
     ClearRawBytes hcRxChunk;
     IF HC_TRANSPORT = "socket" THEN
       IF NOT hcConnected THEN
@@ -211,12 +221,15 @@ MODULE HolecellLink
         hcRxState := 0;
       ENDIF
       SocketReceive hcClient \RawData:=hcRxChunk \Time:=HC_POLL_S;
-    ELSE
+    ELSEIF want = 1 THEN
       PackRawBytes ReadBin(hcChan \Time:=HC_POLL_S), hcRxChunk, 1 \IntX:=USINT;
+    ELSE
+      ReadRawBytes hcChan, hcRxChunk, want \Time:=HC_FRAME_S;
     ENDIF
     RETURN RawBytesLen(hcRxChunk);
   ERROR
     IF ERRNO = ERR_DEV_MAXTIME OR ERRNO = ERR_SOCK_TIMEOUT THEN
+      IF want > 1 hcRxState := 0;
       RETURN 0;
     ELSEIF ERRNO = ERR_SOCK_CLOSED THEN
       SocketClose hcClient;
@@ -247,17 +260,44 @@ MODULE HolecellLink
   ! host's retransmission.
   PROC hcPollLine()
     VAR num n;
-    VAR num b;
-    n := hcLinkRead();
+    n := hcLinkRead(hcRxWant());
     WHILE n > 0 DO
-      FOR i FROM 1 TO n DO
-        UnpackRawBytes hcRxChunk, i, b \IntX:=USINT;
-        hcRxByte b;
-      ENDFOR
-      n := hcLinkRead();
+      hcRxBytes n;
+      n := hcLinkRead(hcRxWant());
     ENDWHILE
   ENDPROC
 
+  ! bytes the receiver needs next: the rest of a header or of a payload and CRC
+  FUNC num hcRxWant()
+    IF hcRxState = 2 RETURN 4 - hcRxCount;
+    IF hcRxState = 3 RETURN hcRxLen + 4 - hcRxCount;
+    RETURN 1;
+  ENDFUNC
+
+  ! the n bytes of hcRxChunk: sync and header byte by byte, payload in one copy
+  PROC hcRxBytes(num n)
+    VAR num i := 1;
+    VAR num b;
+    VAR num k;
+    WHILE i <= n DO
+      IF hcRxState = 3 THEN
+        k := Min(n - i + 1, hcRxLen + 4 - hcRxCount);
+        CopyRawBytes hcRxChunk, i, hcRxPay, hcRxCount + 1 \NoOfBytes:=k;
+        hcRxCount := hcRxCount + k;
+        i := i + k;
+        IF hcRxCount = hcRxLen + 4 THEN
+          hcRxState := 0;
+          hcFrameDone;
+        ENDIF
+      ELSE
+        UnpackRawBytes hcRxChunk, i, b \IntX:=USINT;
+        hcRxByte b;
+        i := i + 1;
+      ENDIF
+    ENDWHILE
+  ENDPROC
+
+  ! sync and header (states 0 to 2); state 3 (payload) is hcRxBytes'
   PROC hcRxByte(num b)
     TEST hcRxState
     CASE 0:
@@ -285,13 +325,6 @@ MODULE HolecellLink
           hcRxCount := 0;
           hcRxState := 3;
         ENDIF
-      ENDIF
-    CASE 3:
-      hcRxCount := hcRxCount + 1;
-      PackRawBytes b, hcRxPay, hcRxCount \IntX:=USINT;
-      IF hcRxCount = hcRxLen + 4 THEN
-        hcRxState := 0;
-        hcFrameDone;
       ENDIF
     ENDTEST
   ENDPROC
@@ -391,6 +424,13 @@ MODULE HolecellLink
     DEFAULT:
       hcSendNak hcRxSeq, NAK_UNKNOWN_TYPE, "unknown message type";
     ENDTEST
+  ERROR
+    ! a payload shorter than its message needs: read past its valid bytes
+    IF ERRNO = ERR_OUTOFBND THEN
+      hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "payload too short";
+      RETURN;
+    ENDIF
+    RAISE;
   ENDPROC
 
   PROC hcStatus()
@@ -441,6 +481,9 @@ MODULE HolecellLink
     ENDIF
     hcLoaded := FALSE;
     hcLoadId := id;
+    hcRowsIn := 0;
+    hcStopsIn := 0;
+    hcLoadCrc := HC_CRC32_INIT;
     hcNRows := rows;
     hcNStops := stops;
     hcDt := dtUs / 1000000;
@@ -458,13 +501,23 @@ MODULE HolecellLink
       hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "rows out of range";
       RETURN;
     ENDIF
+    IF first + count <= hcRowsIn THEN
+      ! rows already held (a repeated chunk)
+      hcAck;
+      RETURN;
+    ENDIF
+    IF first <> hcRowsIn THEN
+      hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "rows out of order";
+      RETURN;
+    ENDIF
     FOR r FROM 1 TO count DO
       FOR a FROM 1 TO 6 DO
         UnpackRawBytes hcRxPay, 6 + 24 * (r - 1) + 4 * (a - 1), v \IntX:=DINT;
-        hcRowsUdeg{first + r, a} := v;
         hcRows{first + r, a} := DnumToNum(v / 1000000);
       ENDFOR
     ENDFOR
+    hcLoadCrc := hcCrcRaw(hcLoadCrc, hcRxPay, 6, 24 * count);
+    hcRowsIn := first + count;
     hcAck;
   ENDPROC
 
@@ -478,10 +531,24 @@ MODULE HolecellLink
       hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "stops out of range";
       RETURN;
     ENDIF
+    IF first + count <= hcStopsIn THEN
+      hcAck;
+      RETURN;
+    ENDIF
+    IF first <> hcStopsIn OR hcRowsIn < hcNRows THEN
+      hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "stops out of order or before the rows";
+      RETURN;
+    ENDIF
     FOR s FROM 1 TO count DO
       UnpackRawBytes hcRxPay, 4 + 4 * (s - 1), row \IntX:=UDINT;
+      IF row >= hcNRows THEN
+        hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "stop row beyond the rows";
+        RETURN;
+      ENDIF
       hcStops{first + s} := row + 1;
     ENDFOR
+    hcLoadCrc := hcCrcRaw(hcLoadCrc, hcRxPay, 4, 4 * count);
+    hcStopsIn := first + count;
     hcAck;
   ENDPROC
 
@@ -489,6 +556,10 @@ MODULE HolecellLink
     VAR dnum id;
     VAR num row;
     UnpackRawBytes hcRxPay, 1, id \IntX:=UDINT;
+    IF hcRowsIn < hcNRows OR hcStopsIn < hcNStops THEN
+      hcSendNak hcRxSeq, NAK_REFUSED, "rows or stops missing";
+      RETURN;
+    ENDIF
     IF id <> hcLoadId OR id <> hcTrajectoryId() THEN
       hcSendNak hcRxSeq, NAK_REFUSED, "trajectory id does not match the data";
       RETURN;
@@ -514,26 +585,11 @@ MODULE HolecellLink
     hcAck;
   ENDPROC
 
-  ! CRC-32 of the rows (int32 LE micro-degrees) followed by the stop rows (u32 LE).
-  ! From the received integers (dnum): a num keeps integers exact only up to
-  ! 8388608, so micro-degrees rebuilt from num degrees differ past 8.4 deg.
+  ! CRC-32 of the rows (int32 LE micro-degrees) followed by the stop rows (u32 LE),
+  ! accumulated over the payloads as they arrived (hcLoadRows, hcLoadStops)
   FUNC dnum hcTrajectoryId()
-    VAR rawbytes b;
     VAR dnum c;
-    c := HC_CRC32_INIT;
-    FOR r FROM 1 TO hcNRows DO
-      FOR a FROM 1 TO 6 DO
-        PackRawBytes hcRowsUdeg{r, a}, b, 1 \IntX:=DINT;
-        c := hcCrcRaw(c, b, 1, 4);
-      ENDFOR
-    ENDFOR
-    IF hcNStops > 0 THEN
-      FOR s FROM 1 TO hcNStops DO
-        PackRawBytes hcStops{s} - 1, b, 1 \IntX:=UDINT;
-        c := hcCrcRaw(c, b, 1, 4);
-      ENDFOR
-    ENDIF
-    c := BitXOrDnum(c, HC_CRC32_INIT);
+    c := BitXOrDnum(hcLoadCrc, HC_CRC32_INIT);
     IF c = 0 c := 1;
     RETURN c;
   ENDFUNC
@@ -580,11 +636,21 @@ MODULE HolecellLink
 
   ! One via-point per call: every HC_ROW_STEP-th row with a zone, timed with \T
   ! so the motion keeps the planner's timing; the target row as a fine point.
+  ! Every move is \Conc (the program keeps serving the link: a STOP waits for
+  ! at most one queued move); in position once the arm is at the target row.
   PROC hcMotionStep()
     VAR num next;
     VAR num dir;
     VAR jointtarget jt;
     IF hcState <> ST_MOVING RETURN;
+    IF hcPos = hcTargetRow THEN
+      IF hcArmAtRow(hcTargetRow) THEN
+        hcAtStop := hcTargetStop;
+        hcTargetStop := -1;
+        hcState := ST_IN_POSITION;
+      ENDIF
+      RETURN;
+    ENDIF
     dir := 1;
     IF hcTargetRow < hcPos dir := -1;
     next := hcPos + dir * HC_ROW_STEP;
@@ -593,16 +659,24 @@ MODULE HolecellLink
     jt.robax := [hcRows{next, 1}, hcRows{next, 2}, hcRows{next, 3},
                  hcRows{next, 4}, hcRows{next, 5}, hcRows{next, 6}];
     IF next = hcTargetRow THEN
-      MoveAbsJ jt \NoEOffs, v1000 \T:=Abs(next - hcPos) * hcDt, fine, tool0;
-      hcPos := next;
-      hcAtStop := hcTargetStop;
-      hcTargetStop := -1;
-      hcState := ST_IN_POSITION;
+      MoveAbsJ \Conc, jt \NoEOffs, v1000 \T:=Abs(next - hcPos) * hcDt, fine, tool0;
     ELSE
       MoveAbsJ \Conc, jt \NoEOffs, v1000 \T:=HC_ROW_STEP * hcDt, z5, tool0;
-      hcPos := next;
     ENDIF
+    hcPos := next;
   ENDPROC
+
+  ! whether every joint is within HC_IN_POS_TOL_DEG of row r
+  FUNC bool hcArmAtRow(num r)
+    VAR jointtarget j;
+    j := CJointT();
+    RETURN Abs(hcRows{r, 1} - j.robax.rax_1) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 2} - j.robax.rax_2) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 3} - j.robax.rax_3) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 4} - j.robax.rax_4) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 5} - j.robax.rax_5) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 6} - j.robax.rax_6) <= HC_IN_POS_TOL_DEG;
+  ENDFUNC
 
   PROC hcHalt(num state, num fault)
     IF hcState = ST_MOVING THEN
@@ -617,7 +691,8 @@ MODULE HolecellLink
     hcAtStop := -1;
   ENDPROC
 
-  ! the row nearest the arm's joints among the last via-points issued
+  ! the row nearest the arm's joints among the last via-points issued (at most
+  ! five concurrent moves and the final one are queued)
   FUNC num hcNearestRow(num around)
     VAR jointtarget j;
     VAR num best;
@@ -625,7 +700,7 @@ MODULE HolecellLink
     VAR num e;
     j := CJointT();
     best := around;
-    FOR r FROM Max(1, around - 5 * HC_ROW_STEP) TO Min(hcNRows, around + 5 * HC_ROW_STEP) DO
+    FOR r FROM Max(1, around - 6 * HC_ROW_STEP) TO Min(hcNRows, around + 6 * HC_ROW_STEP) DO
       e := Abs(hcRows{r, 1} - j.robax.rax_1) + Abs(hcRows{r, 2} - j.robax.rax_2)
            + Abs(hcRows{r, 3} - j.robax.rax_3) + Abs(hcRows{r, 4} - j.robax.rax_4)
            + Abs(hcRows{r, 5} - j.robax.rax_5) + Abs(hcRows{r, 6} - j.robax.rax_6);

@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from time import monotonic
+
 from cell.rapid.interp.builtins.base import Arg, Builtin, Opt
 from cell.rapid.interp.errors import RapidRunError
 from cell.rapid.interp.rtypes import F32, RawBytes
@@ -55,9 +57,9 @@ def _read_raw(st, line, h, ref, n, time=None):
     if want != n or not 1 <= want <= 1024:
         raise RapidRunError("ERR_ARGVALERR", f"NoOfBytes {float(n):g} outside 1..1024", line)
     dev, out = _dev(h, line), b""
-    limit = DEFAULT_TIME_S if time is None else float(time)
+    end = monotonic() + (DEFAULT_TIME_S if time is None else float(time))
     while len(out) < want:
-        got = dev.read(want - len(out), limit)
+        got = dev.read(want - len(out), max(0.0, end - monotonic()))
         if not got:
             raise RapidRunError("ERR_DEV_MAXTIME", f"{len(out)} of {want} bytes within \\Time",
                                 line)  # fmt: skip
