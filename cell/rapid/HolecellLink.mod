@@ -153,6 +153,8 @@ MODULE HolecellLink
     IF hcEstopLatched THEN
       hcState := ST_ESTOP;
       hcFault := FLT_ESTOP;
+      hcAtStop := -1;
+      hcTargetStop := -1;
     ENDIF
   ENDPROC
 
@@ -407,16 +409,20 @@ MODULE HolecellLink
     CASE MSG_MOVE_TO_STOP:
       hcMoveToStop;
     CASE MSG_STOP:
-      hcHalt ST_STOPPED, FLT_NONE;
+      ! a latched emergency stop or fault stays until RESET
+      IF hcState = ST_MOVING hcHalt ST_STOPPED, FLT_NONE;
       hcAck;
     CASE MSG_ABORT:
-      hcHalt ST_IDLE, FLT_NONE;
+      IF hcState = ST_MOVING hcHalt ST_STOPPED, FLT_NONE;
       hcLoaded := FALSE;
       hcTrajId := 0;
+      hcAtStop := -1;
+      IF hcState <> ST_ESTOP AND hcState <> ST_FAULT hcState := ST_IDLE;
       hcAck;
     CASE MSG_RESET:
       IF hcState = ST_ESTOP OR hcState = ST_FAULT THEN
-        hcState := ST_STOPPED;
+        hcState := ST_IDLE;
+        IF hcLoaded hcState := ST_STOPPED;
       ENDIF
       hcEstopLatched := FALSE;
       hcFault := FLT_NONE;
