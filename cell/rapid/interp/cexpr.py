@@ -153,9 +153,7 @@ class ExprCompiler:
         op = str(node.children[1])
         a, b, t = self._numeric_pair(node)
         if t.name == "?" and (
-            a.type != b.type
-            or base(a.type.name) not in ("bool", "string")
-            or op not in ("=", "<>")
+            a.type != b.type or base(a.type.name) not in ("bool", "string") or op not in ("=", "<>")
         ):
             raise self.err(f"cannot compare {a.type} {op} {b.type}", node)
         fa, fb = a.fn, b.fn

@@ -56,7 +56,7 @@ class Builtin:
 
     def bind(self, c, args, node) -> Expr:
         """Check the call's arguments in compiler ``c``; the call as an expression."""
-        pos, opts, n_req = [], {}, 0
+        pos, opts, n_req, after = [], {}, 0, {}
         for a in args:
             if getattr(a, "data", None) == "opt_arg":
                 opts_name = str(a.children[0])
@@ -65,9 +65,7 @@ class Builtin:
                     raise c.err(f"{self.name} has no optional argument \\{opts_name}", a)
                 if o.name.lower() in opts:
                     raise c.err(f"\\{o.name} given twice to {self.name}", a)
-                if o.after != n_req:
-                    raise c.err(f"\\{o.name} of {self.name} must follow argument {o.after} "
-                                f"(found after {n_req})", a)  # fmt: skip
+                after[o.name.lower()] = n_req
                 opts[o.name.lower()] = (o, a.children[1] if len(a.children) > 1 else None, a)
             else:
                 pos.append(a)
@@ -76,6 +74,10 @@ class Builtin:
             names = ", ".join(x.name for x in self.args)
             raise c.err(f"{self.name} takes {len(self.args)} arguments ({names}), "
                         f"{len(pos)} given", node)  # fmt: skip
+        for key, (o, _, a) in opts.items():
+            if o.after != after[key]:
+                raise c.err(f"\\{o.name} of {self.name} must follow argument {o.after} "
+                            f"(found after {after[key]})", a)  # fmt: skip
         groups: dict[str, str] = {}
         for o, _, a in opts.values():
             if o.group and o.group in groups:
