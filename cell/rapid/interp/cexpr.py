@@ -85,7 +85,7 @@ class ExprCompiler:
         k = node.data
         if k == "num_lit":
             v = float(node.children[0])
-            return Expr(lambda fr, v=F32(v): v, NUM, v)
+            return Expr(constant(F32(v)), NUM, v)
         if k == "str_lit":
             s = _string_literal(str(node.children[0]))
             if len(s) > 80:
@@ -126,7 +126,7 @@ class ExprCompiler:
             raise self.err(f"unary {sign} on {e.type}", node)
         if e.lit is not None:
             v = -e.lit if str(sign) == "-" else e.lit
-            return Expr(lambda fr, v=F32(v): v, NUM, v)
+            return Expr(constant(F32(v)), NUM, v)
         fn = e.fn
         return Expr((lambda fr: -fn(fr)) if str(sign) == "-" else fn, Type(base(e.type.name)))
 

@@ -207,6 +207,30 @@ class Program:
         except RapidRunError as e:
             raise self._stopped(e) from None
 
+    def call(self, name: str, *args, host=None):
+        """Call FUNC or PROC ``name`` with Python values (num as float32, dnum as float; a VAR
+        argument's object, e.g. a RawBytes, is passed by reference); the FUNC's value."""
+        r = self.routines.get(name.lower())
+        if r is None or len(args) != len(r.params):
+            raise RapidLoadError(f"no routine {name} with {len(args)} arguments", 0,
+                                 self.state.source)  # fmt: skip
+        self.state.host = host
+        fr = [None] * r.scope.n_slots
+        for p, a in zip(r.params, args, strict=True):
+            if p.access != "in":
+                fr[p.slot] = ([a], 0)
+            else:
+                fr[p.slot] = {"num": F32, "dnum": float}.get(base(p.type.name), copy_value)(a)
+        for slot, init in r.locals_init:
+            fr[slot] = init()
+        try:
+            res = r.run(fr)
+        except Propagate as p:
+            raise self._stopped(p.err) from None
+        except RapidRunError as e:
+            raise self._stopped(e) from None
+        return None if res is None else res.value
+
     def _stopped(self, e: RapidRunError) -> RapidStopped:
         return RapidStopped(f"execution stopped: {e.text}", e.line, self.state.source)
 

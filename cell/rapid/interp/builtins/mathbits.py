@@ -1,6 +1,6 @@
 """Arithmetic, conversion and bit built-ins: Abs, Round, Trunc, Max, Min, Sqrt, NumToDnum,
-DnumToNum, BitAndDnum, BitOrDnum, BitXOrDnum, BitRShDnum, BitLShDnum, NumToStr, StrLen (RAPID reference
-manual, "Functions"). num results are single precision, dnum results double."""
+DnumToNum, BitAndDnum, BitOrDnum, BitXOrDnum, BitRShDnum, BitLShDnum, NumToStr, StrLen (RAPID
+reference manual, "Functions"). num results are single precision, dnum results double."""
 
 from __future__ import annotations
 

@@ -60,8 +60,9 @@ def pack(
         lo, hi = _num_limit(code, isinstance(value, F32), *_range(code))
         v = float(value)
         if v != int(v) or not lo <= v <= hi:
+            kind = "num" if isinstance(value, F32) else "dnum"
             raise RapidRunError("ERR_ARGVALERR", f"{v:.17g} is not an integer in {lo}..{hi} "
-                                f"({'num' if isinstance(value, F32) else 'dnum'})", line)  # fmt: skip
+                                f"({kind})", line)  # fmt: skip
         data = struct.pack(end + _FMT[code], int(v))
     elif float4:
         if not isinstance(value, F32 | float):
