@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 from cell_fixtures import SmallCell, link_for, steady_drift
 
 from cell.link.client import ControllerClient, LinkOptions
@@ -39,13 +40,15 @@ def _inprocess_run(sc: SmallCell, run_dir: Path, sim: SimCell, link: LinkOptions
         files.store.close()
 
 
+@pytest.mark.parametrize("transport", ["pty", "socket"])
 def test_dropped_corrupted_frames_and_a_disconnect(
-    small_cell: SmallCell, tmp_path: Path, controller: str
+    small_cell: SmallCell, tmp_path: Path, controller: str, transport: str
 ) -> None:
     faults = FaultPlan(drop=0.05, corrupt=0.02, disconnect_after=50, disconnect_s=1.5, seed=7)
     link = LinkOptions(response_timeout_s=0.04, retries=8, heartbeat_period_s=0.1)
     world = WorldOptions(speed=20.0, drift=steady_drift())
-    with SimCell.start(small_cell.cell, world, faults, controller=controller) as sim:
+    with SimCell.start(small_cell.cell, world, faults, transport,
+                       controller=controller) as sim:  # fmt: skip
         result, stored, events = _inprocess_run(small_cell, tmp_path, sim, link)
         server = sim.server
     assert result.status == "done"
