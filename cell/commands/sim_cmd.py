@@ -96,6 +96,8 @@ def run_sim(args: argparse.Namespace) -> int:
             t_end = None if args.duration_s is None else time.monotonic() + args.duration_s
             while t_end is None or time.monotonic() < t_end:
                 time.sleep(0.2)
+                if getattr(sim.controller, "error", None) is not None:  # the RAPID program
+                    raise CellError(f"controller stopped: {sim.controller.error}")
         finally:
             cam.close()
     return 0
