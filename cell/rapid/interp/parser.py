@@ -21,8 +21,10 @@ def _parser() -> Lark:
     )
 
 
+@lru_cache(maxsize=16)
 def parse(text: str, source: str = "<module>") -> Tree:
-    """The parse tree of one module (``module`` node); RapidLoadError on a syntax error."""
+    """The parse tree of one module (``module`` node); RapidLoadError on a syntax error. Kept
+    for the same text (the compiler only reads the tree)."""
     try:
         return _parser().parse(text).children[0]
     except UnexpectedToken as exc:
