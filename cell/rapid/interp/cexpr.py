@@ -301,8 +301,12 @@ class ExprCompiler:
     def _select_loc(self, loc, t: Type, sel):
         line = line_of(sel)
         if sel.data == "index":
-            _get, et = self._select(lambda fr: (lambda ck: ck[0][ck[1]])(loc(fr)), t, sel)
+            if not t.ndim:
+                raise self.err(f"{t} is not an array", sel)
             idx = [self.expr(c, NUM).fn for c in sel.children]
+            if len(idx) != t.ndim:
+                raise self.err(f"{len(idx)} indices for an array of {t.ndim} dimensions", sel)
+            et = t.elem
 
             def at(fr):
                 c, k = loc(fr)

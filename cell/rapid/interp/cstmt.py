@@ -9,7 +9,15 @@ from __future__ import annotations
 
 from cell.rapid.interp.cexpr import BOOL, NUM, Expr, ExprCompiler, line_of
 from cell.rapid.interp.errors import RapidRunError, RapidStopped
-from cell.rapid.interp.rtypes import F32, Type, assignable, base, converter, copy_value
+from cell.rapid.interp.rtypes import (
+    F32,
+    Type,
+    assignable,
+    base,
+    check_string,
+    converter,
+    copy_value,
+)
 from cell.rapid.interp.scope import Routine
 
 #: RETRY more often than this on one error stops the program (RobotWare's default)
@@ -110,9 +118,7 @@ class StmtCompiler(ExprCompiler):
         target, value = node.children
         loc, t, _ = self.location(target)
         v = self.expr(value, t).fn
-        if base(t.name) in ("string",):
-            from cell.rapid.interp.rtypes import check_string
-
+        if base(t.name) == "string":
             line = line_of(node)
 
             def assign_s(fr):

@@ -33,10 +33,12 @@ def _predefined(scope: Scope) -> None:
     scope.declare("v1000", Type("speeddata"), "const", 0,
                   Record("speeddata", {"v_tcp": F32(1000), "v_ori": F32(500),
                                        "v_leax": F32(5000), "v_reax": F32(1000)}))  # fmt: skip
-    for name, mm in (("fine", 0), ("z5", 5)):
+    # fine := [TRUE, 0, 0, 0, 0, 0, 0]; z5 := [FALSE, 5, 8, 8, 0.8, 8, 0.8] (zonedata)
+    for name, values in (("fine", (0, 0, 0, 0, 0, 0)), ("z5", (5, 8, 8, 0.8, 8, 0.8))):
         zone = default("zonedata")
-        zone.f.update(finep=mm == 0, pzone_tcp=F32(mm), pzone_ori=F32(mm * 1.5),
-                      pzone_eoffs=F32(mm * 1.5), zone_ori=F32(mm * 0.0375 * 2))  # fmt: skip
+        fields = ("pzone_tcp", "pzone_ori", "pzone_eoffs", "zone_ori", "zone_leax", "zone_reax")
+        zone.f.update({f: F32(v) for f, v in zip(fields, values, strict=True)})
+        zone.f["finep"] = name == "fine"
         scope.declare(name, Type("zonedata"), "const", 0, zone)
     scope.declare("tool0", Type("tooldata"), "pers", 0)
 
