@@ -129,7 +129,7 @@ def test_error_handlers(prog: Program) -> None:
 
 def test_num_keeps_integers_exact_to_8388608_only(prog: Program) -> None:
     prog.call("packBig", 8388608)
-    with pytest.raises(RapidStopped, match="ERR_ARGVALERR.*8388610"):
+    with pytest.raises(RapidStopped, match=r"ERR_ARGVALERR.*8388610"):
         prog.call("packBig", 8388610)
     prog.call("packBigD", 4294967295)
     assert prog.global_value("raw").valid() == b"\xff\xff\xff\xff"
