@@ -36,6 +36,7 @@ from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
+from cell.sim.truth import CellTruth
 from cell.sim.world import WorldOptions
 from planner import Options, plan_tour
 from robots.thermal.drift import DriftSettings, WarmUp
@@ -98,7 +99,7 @@ def faulty_runs(cell, tour, root: Path, seeds: list[int], controller: str) -> No
         # the interpreted module answers a full LOAD_ROWS frame in tens of ms
         link = LinkOptions(response_timeout_s=0.05 if controller == "python" else 0.15, retries=8)
         t0 = time.perf_counter()
-        world = WorldOptions(speed=20.0, drift=STEADY, seed=seed)
+        world = WorldOptions(speed=20.0, drift=STEADY, truth=CellTruth.zero(seed))
         with SimCell.start(cell, world, faults, controller=controller) as sim:
             result, stored = run_once(cell, tour, root / f"faulty{seed}", sim, link)
             srv = sim.server

@@ -27,6 +27,7 @@ import numpy as np
 import yaml
 
 from cell.config import HoleInCell, builtin_cell_path, parse_cell
+from cell.gdt.datums import without_drawing
 from planner.viewpoints import hole_candidates
 from robots.transforms import matrix_to_rpy
 
@@ -204,6 +205,7 @@ def cluttered_cell(n_holes: int, n_parts: int, seed: int, variant: int | None = 
         for h in stream
     )
     data["part"]["holes"] = _select_holes(data, shifted, n_holes)
+    without_drawing(data, 5e-5)  # the subset may leave datum features out
     data["reference_targets"] = [
         {"id": "R1", "position": [0.85, -0.68, TABLE_TOP_Z + 0.001], "normal": [0, 0, 1],
          "diameter": 0.01},

@@ -20,7 +20,9 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError,
 
 from cell.config_checks import cell_problems
 from cell.config_mesh import MeshSpec
+from cell.config_target import CalibrationTargetBoard
 from cell.errors import ConfigError
+from cell.gdt.datums import Alignment, Datum, Tolerances, gdt_problems
 from cell.holes_csv import read_holes_csv
 from cell.uncertainty.materials import (
     BUILTIN_MATERIALS,
@@ -170,6 +172,8 @@ class Hole(_Strict):
     normal: Vec3
     diameter: Positive
     tolerance: Positive | None = None
+    #: GD&T position and size tolerances (:mod:`cell.gdt.datums`, docs/gdt.md)
+    tolerances: Tolerances | None = None
 
     _unit_normal = field_validator("normal")(lambda cls, v: _unit(v))
 
@@ -193,6 +197,9 @@ class Part(_Strict):
     ) = None
     #: standard uncertainty of ``temperature_c`` (K)
     u_temperature_K: Annotated[float, Field(gt=0, le=10)] | None = None  # noqa: N815
+    #: datum features in precedence and the run's alignment (:mod:`cell.gdt.datums`)
+    datums: list[Datum] = []
+    alignment: Alignment | None = None
 
     _material = field_validator("material", mode="before")(lambda cls, v: material_field(v))
 
@@ -208,6 +215,17 @@ class ReferenceTarget(_Strict):
     diameter: Positive
 
     _unit_normal = field_validator("normal")(lambda cls, v: _unit(v))
+
+
+class CalibrationTarget(CalibrationTargetBoard):
+    """``calibration_target``: the plate board (:mod:`cell.config_target`) and its nominal
+    pose in the cell."""
+
+    pose: Pose
+
+    def T_cell_target(self) -> np.ndarray:
+        """Nominal pose of the board frame in the cell."""
+        return self.pose.matrix()
 
 
 @dataclass(frozen=True)
@@ -230,6 +248,7 @@ class CellConfig(_Strict):
     part: Part
     environment: Environment = Environment()
     reference_targets: list[ReferenceTarget] = []
+    calibration_target: CalibrationTarget | None = None
 
     _source_path: Path | None = PrivateAttr(default=None)
     _raw_text: str = PrivateAttr(default="")
@@ -285,13 +304,14 @@ class CellConfig(_Strict):
         return [s.to_shape(np.eye(4), f"tool{i}", d) for i, s in enumerate(self.tool.shapes)]
 
     def obstacle_shapes(self) -> list[Shape]:
-        """Part and environment obstacles, poses in the cell frame."""
+        """Part and environment obstacles and the calibration plate, poses in the cell frame."""
         T_part, d = self.T_cell_part(), self.base_dir
         part = [s.to_shape(T_part, f"part{i}", d) for i, s in enumerate(self.part.obstacles)]
         env = [
             s.to_shape(np.eye(4), f"env{i}", d) for i, s in enumerate(self.environment.obstacles)
         ]
-        return part + env
+        t = self.calibration_target
+        return part + ([] if t is None else [t.plate_shape(t.T_cell_target())]) + env
 
     def _relative_to_cell(self, path: str) -> Path:
         p = Path(path).expanduser()
@@ -409,7 +429,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
     cfg._raw_text = text
     if cfg.part.holes_csv is not None:
         cfg = _with_csv_holes(cfg, source, source_path, text)
-    problems = cell_problems(cfg)
+    problems = gdt_problems(cfg) or cell_problems(cfg)
     if problems:
         raise ConfigError(source, problems)
     return cfg

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from cell.config_target import read_corners
 from robots import LimitsError, RobotModelError
 from robots.meshes import MeshFileError
 
@@ -57,7 +58,17 @@ def path_problems(cfg: CellConfig) -> list[Problem]:
     for i, folder in enumerate(cfg.package_paths()):
         if not folder.is_dir():
             problems.append((f"robot.package_paths[{i}]", str(folder), "no such folder"))
-    return problems
+    return problems + target_problems(cfg)
+
+
+def target_problems(cfg: CellConfig) -> list[Problem]:
+    """A measured corner file of the calibration target that is missing or wrong."""
+    t = cfg.calibration_target
+    path = None if t is None else t.corners_path(cfg.base_dir)
+    if path is None:
+        return []
+    _, problems = read_corners(path, t.target_spec().object_points(), t.pitch_m)
+    return [("calibration_target.corners_file", str(path), p) for p in problems]
 
 
 def mesh_problems(cfg: CellConfig) -> list[Problem]:

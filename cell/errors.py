@@ -15,3 +15,7 @@ class ConfigError(CellError):
         self.problems = problems
         lines = [f"{path}: {field}: {msg} (value: {value!r})" for field, value, msg in problems]
         super().__init__("\n".join(lines) if lines else f"{path}: invalid cell file")
+
+
+class TruthFileError(ConfigError):
+    """A simulated-truth file (``truth.yaml``) is invalid; same payload as :class:`ConfigError`."""

@@ -58,6 +58,10 @@ def _summary(cfg: CellConfig) -> list[str]:
         f"cell      {_count(len(cfg.environment.obstacles), 'environment obstacle')}, "
         f"{_count(len(cfg.reference_targets), 'reference target')}",
     ]
+    t = cfg.calibration_target
+    if t is not None:
+        lines.append(f"target    {t.pattern} {t.cols} x {t.rows}, pitch {t.pitch_m * 1e3:g} mm, "
+                     f"at xyz {t.pose.xyz} (the plate is an obstacle)")  # fmt: skip
     if arm.collision.excluded_pairs:
         lines.append(
             f"note      bodies touching at q=0, not checked: {arm.collision.excluded_pairs}"
@@ -95,6 +99,9 @@ def run_show(args: argparse.Namespace) -> int:
         (f"{t.id}*", t.diameter, np.array(t.position), np.array(t.normal))
         for t in cfg.reference_targets
     ]
+    if cfg.calibration_target is not None:  # its centre, viewed along its normal
+        t = cfg.calibration_target
+        rows.append(("target#", t.pitch_m, *t.centre_and_normal(t.T_cell_target())))
     for hid, diameter, position, normal in rows:
         r = hole_reach(arm, hid, position, normal, cfg.tool.standoff_m, step)
         unreachable += not r.reachable
@@ -107,5 +114,7 @@ def run_show(args: argparse.Namespace) -> int:
             f"{hid:8s} {diameter * 1e3:8.1f} {r.n_solutions:8d} {r.n_free:6d} "
             f"{r.rolls_free:4d}/{r.n_rolls:<4d}  {note}"
         )
-    print(f"\n* reference target.  {len(rows) - unreachable} of {len(rows)} reachable.")
+    legend = "* reference target" + ("; # calibration target's centre (diam: its pitch)"
+                                     if cfg.calibration_target is not None else "")  # fmt: skip
+    print(f"\n{legend}.  {len(rows) - unreachable} of {len(rows)} reachable.")
     return 1 if unreachable else 0

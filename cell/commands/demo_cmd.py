@@ -39,16 +39,25 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--part-temperature",
         type=part_temperature_c,
-        default=23.0,
+        default=None,
         metavar="C",
-        help="the simulated part's true temperature (default 23 degC; the run is "
-        "given a thermometer reading of it)",
+        help="the simulated part's true temperature (default: the truth file's, else 23 "
+        "degC; the run is given a thermometer reading of it)",
     )
-    p.add_argument(
+    world = p.add_mutually_exclusive_group()
+    world.add_argument(
         "--ideal",
         action="store_true",
-        help="a perfect simulated arm and head (no repeatability scatter, the head "
-        "exactly as calibrated): only image noise and thermal drift",
+        help="a perfect simulated arm and head (no geometric error, no repeatability "
+        "scatter, the head exactly as calibrated): only image noise and thermal drift",
+    )
+    world.add_argument(
+        "--truth",
+        metavar="TRUTH.yaml",
+        default=None,
+        help="every hidden error of the simulated cell (docs/calibration.md, 'the simulated "
+        "truth'; fields left out are drawn from its seed, else --seed; write one with "
+        "holecell truth draw)",
     )
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
@@ -125,6 +134,12 @@ def _part(part: dict | None) -> str:
 def run_demo_cmd(args: argparse.Namespace) -> int:
     """Handler of ``holecell demo``."""
     out = Path(args.out) if args.out else Path("out") / time.strftime("demo-%Y%m%d-%H%M%S")
+    truth = None
+    if args.truth is not None:
+        from cell.config import load_builtin_cell
+        from cell.sim.truth import CellTruth
+
+        truth = CellTruth.load(args.truth, load_builtin_cell(), seed=args.seed)
     bars = None if args.quiet else RunBars(0)
     res = run_demo(
         out,
@@ -134,6 +149,7 @@ def run_demo_cmd(args: argparse.Namespace) -> int:
             part_temperature_c=args.part_temperature,
             realistic=not args.ideal,
             operator=args.operator,
+            truth=truth,
         ),
         _plan_bars(args.quiet),
         _progress(bars),

@@ -21,6 +21,7 @@ from cell.errors import CellError
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
+from cell.sim.truth import CellTruth
 from cell.sim.world import WorldOptions
 
 
@@ -65,6 +66,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--missing", nargs="*", default=(), help="hole ids (of the cell) that are not there"
     )
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--truth",
+        metavar="TRUTH.yaml",
+        default=None,
+        help="every hidden error of the simulated cell (docs/calibration.md; fields left out "
+        "are drawn from its seed, else --seed); default: no geometric error",
+    )
     p.add_argument("--duration-s", type=positive_float, default=None, help="stop after this long")
     p.set_defaults(handler=run_sim)
 
@@ -86,7 +94,9 @@ def run_sim(args: argparse.Namespace) -> int:
         missing_holes=tuple(args.missing),
         seed=args.seed,
     )
-    world = WorldOptions(speed=args.speed, drift_offset_s=args.drift_offset_s, seed=args.seed)
+    truth = (CellTruth.zero(args.seed) if args.truth is None
+             else CellTruth.load(args.truth, cell, seed=args.seed))  # fmt: skip
+    world = WorldOptions(speed=args.speed, drift_offset_s=args.drift_offset_s, truth=truth)
     with SimCell.start(cell, world, faults, args.transport, controller=args.controller) as sim:
         cam = CameraServer(sim.camera).start()
         try:

@@ -20,6 +20,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from cell.gdt.html import gdt_section
+from cell.gdt.report_fields import report_evaluation
 from cell.review.report_html import render_html
 from cell.review.store import Store
 from cell.run.results import HoleResult
@@ -129,10 +131,12 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
         events = store.events()
         info, planned = {**store.run_info(), "run_dir": str(run_dir)}, store.planned()
         reference = [(o[0], o[3]) for o in store.reference_observations()]
-    html = render_html(summ, info, results, planned, operator, reference)
+    gdt, results = report_evaluation(info, results, rows, summ)  # cell.gdt, docs/gdt.md
+    html = render_html(summ, info, results, planned, operator, reference,
+                       gdt_section(gdt.fields()), gdt.alignment == "fixture")  # fmt: skip
     _atomic_write(run_dir / "report.html", html)
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
-           "events": events}  # fmt: skip
+           "events": events, **gdt.fields()}  # fmt: skip
     (run_dir / "report.json").write_text(json.dumps(doc, indent=1))
     with (run_dir / "report.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS)
@@ -165,6 +169,12 @@ def format_summary(summ: dict[str, Any]) -> str:
         f"{summ['holes_nonconforming']} nonconformance proven "
         f"(rule {summ['decision_rule'] or '-'})",
     ]
+    chars = summ.get("characteristics")
+    if chars:  # cell.gdt: the drawing's characteristics in the run's alignment
+        lines.append(f"characteristics {chars['conformance']} conformance proven, "
+                     f"{chars['inconclusive']} inconclusive, {chars['nonconformance']} "
+                     f"nonconformance proven, {chars['not_evaluated']} not evaluated "
+                     f"(alignment {summ['alignment']})")  # fmt: skip
     part = summ.get("part")
     if part:
         lines.append(f"part            {part['temperature_c']:.2f} degC "

@@ -246,20 +246,26 @@ def _budget_table(results: list[HoleResult]) -> str:
 
 def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleResult],
                 planned: list[tuple[str, int, dict]], operator: str = "",
-                reference: list[tuple[float, Any]] | None = None) -> str:  # fmt: skip
+                reference: list[tuple[float, Any]] | None = None,
+                gdt_html: str = "", fixture_plot: bool = True) -> str:  # fmt: skip
     """The whole ``report.html`` document; ``reference``: (controller time s, readings degC)
-    of the reference-target observations, for the thermal plot."""
+    of the reference-target observations, for the thermal plot; ``gdt_html``: the alignment
+    and characteristics (:mod:`cell.gdt.html`), after the counts; ``fixture_plot``: draw the
+    deviation vectors in the part frame (False when the run is evaluated in a datum frame,
+    whose own plot ``gdt_html`` holds)."""
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>Inspection report {escape(summ['cell'])}</title><style>{CSS}</style></head><body>",
         f"<h1>Inspection report: {escape(summ['cell'])}</h1>",
         _header(summ, info, operator, results),
-        "<h2>Result</h2>", _counts(summ),
+        "<h2>Result</h2>", _counts(summ), gdt_html,
         "<h2>Holes</h2>", _hole_table(results, planned),
         "<p class='note'>Position deviation: distance of the measured centre from the nominal in "
-        "the plane perpendicular to the nominal axis. U: expanded uncertainty (k = 2) of the "
-        "budget below. Decisions per ISO 14253-1 on both characteristics.</p>",
-        "<h2>Deviation vectors over the part</h2>", _vector_plot(results),
+        "the plane perpendicular to the nominal axis, in the run's alignment (above; the "
+        "positions are in the part frame). U: expanded uncertainty (k = 2). Decisions per "
+        "ISO 14253-1 on both characteristics.</p>",
+        *(["<h2>Deviation vectors over the part</h2>", _vector_plot(results)]
+          if fixture_plot else []),
         "<h2>Position deviation against the tolerance</h2>",
         _bar_plot(results, "position_deviation_m", "U_position_m", "position deviation"),
         "<h2>Diameter deviation against the tolerance</h2>",

@@ -30,6 +30,7 @@ from cell.run.runner import Progress, Runner, RunOptions, RunResult
 from cell.run.setup import RunFiles, check_new_run_dir, start_run
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
+from cell.sim.truth import CellTruth
 from cell.sim.world import SimWorld, WorldOptions
 from cell.uncertainty.decision import DEFAULT_RULE
 from cell.uncertainty.repeatability import repeatability_rp_m
@@ -48,14 +49,18 @@ class DemoOptions:
         reference_rounds: rounds over the reference targets during the warm-up.
         reference_interval_s: simulated seconds between two rounds.
         faults: what the simulated controller does wrong (none by default).
-        seed: seed of the part's true geometry, sensor noise and image noise.
-        part_temperature_c: the simulated part's true temperature (degC); the run is given a
-            thermometer reading of it (``thermometer_sigma_K`` noise, stated as
-            ``u_part_temperature_K``).
+        seed: seed of the part's true geometry, sensor noise and image noise (a ``truth``
+            carries its own).
+        part_temperature_c: the simulated part's true temperature (degC; None: the truth's, or
+            23 degC without one); the run is given a thermometer reading of it
+            (``thermometer_sigma_K`` noise, stated as ``u_part_temperature_K``).
         realistic: the simulated cell has the errors a real one has and the budget claims:
             the arm scatters by its data-sheet repeatability, the true head differs from its
             calibration by a draw from the calibration's uncertainty, the part's expansion
-            coefficient by a draw from its material's (False: a perfect arm and head).
+            coefficient by a draw from its material's (False: a perfect arm and head, no
+            geometric error: :meth:`CellTruth.zero`).
+        truth: every hidden error of the simulated cell (a truth file, ``--truth``); None:
+            no geometric error, and with ``realistic`` the repeatability and head draw above.
         decision_rule: the run's decision rule.
         operator: the report's operator field.
     """
@@ -66,12 +71,17 @@ class DemoOptions:
     reference_interval_s: float = 600.0
     faults: FaultPlan = field(default_factory=FaultPlan)
     seed: int = 0
-    part_temperature_c: float = 23.0
+    part_temperature_c: float | None = None
     thermometer_sigma_K: float = 0.1  # noqa: N815 (unit suffix)
     u_part_temperature_K: float = 0.2  # noqa: N815 (unit suffix)
     realistic: bool = True
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
+    truth: CellTruth | None = None
+
+
+#: the demo's part temperature without a truth file or a figure (degC)
+DEMO_PART_TEMPERATURE_C = 23.0
 
 
 @dataclass
@@ -110,7 +120,7 @@ def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
     """Measurement error against the simulation's true holes (their 20 degC geometry), and the
     coverage of the stated uncertainties: ``|d - d_true| <= U_position`` for the position
     deviation (in the plane of the nominal axis) and ``|D - D_true| <= U_diameter``."""
-    T_part_cell = invert(world.cell.T_cell_part())
+    T_part_cell = invert(world.T_cell_part)  # the true part frame: the part as it lies
     normals = {h.id: np.asarray(h.normal, float) for h in world.cell.part.holes}
     e, e_u, e_d, e_p, cov_p, cov_d = [], [], [], [], [], []
     for r in results:
@@ -197,20 +207,31 @@ def run_demo(
 
 def demo_world(cell: CellConfig, opts: DemoOptions) -> WorldOptions:
     """The simulated cell of the demo: real time until the first reference round (its
-    readings are the cold state), the part at ``part_temperature_c``; with ``realistic`` the
-    arm's data-sheet repeatability, a true head off its calibration and a true expansion
-    coefficient off the material's figure, each drawn from the uncertainty the budget claims."""
-    base = WorldOptions(speed=1.0, drift_offset_s=0.0, seed=opts.seed,
-                        part_temperature_c=opts.part_temperature_c,
+    readings are the cold state), the truth of :func:`demo_truth`; with ``realistic`` a true
+    expansion coefficient off the material's figure, drawn from its stated uncertainty."""
+    base = WorldOptions(speed=1.0, drift_offset_s=0.0, truth=demo_truth(cell, opts),
                         part_thermometer_sigma_K=opts.thermometer_sigma_K)  # fmt: skip
     if not opts.realistic:
         return base
     material, _ = cell.part_material()
-    rng = np.random.default_rng([opts.seed, 0xA1FA])
+    rng = np.random.default_rng([base.seed, 0xA1FA])
     alpha = material.alpha_per_K + rng.normal(0.0, material.u_alpha_per_K)
+    return replace(base, part_alpha_per_K=alpha)
+
+
+def demo_truth(cell: CellConfig, opts: DemoOptions) -> CellTruth:
+    """``opts.truth`` (its part temperature replaced by ``part_temperature_c`` if given); without
+    one no geometric error and, with ``realistic``, the arm's data-sheet repeatability and a
+    head off its calibration by a draw of its stated uncertainty."""
+    t = opts.part_temperature_c
+    if opts.truth is not None:
+        return opts.truth if t is None else replace(opts.truth, part_temperature_c=t)
+    truth = replace(CellTruth.zero(opts.seed),
+                    part_temperature_c=DEMO_PART_TEMPERATURE_C if t is None else t)  # fmt: skip
+    if not opts.realistic:
+        return truth
     rp, _ = repeatability_rp_m(cell.robot.model, cell.robot.repeatability_m)
-    return replace(base, repeatability_rp_m=rp, calibration_sigma_scale=1.0,
-                   part_alpha_per_K=alpha)  # fmt: skip
+    return replace(truth, repeatability_rp_m=rp, calibration_sigma_scale=1.0)
 
 
 def _speed_up(sim: SimCell, opts: DemoOptions, run_progress: Progress | None) -> Progress:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from cell.config import CellConfig, HoleInCell
+from cell.gdt.montecarlo import gdt_extra
 from cell.run.results import HoleResult, deviations
 from cell.uncertainty.budget import combine
 from cell.uncertainty.context import BudgetContext, budget_context, hole_contributions
@@ -91,6 +92,7 @@ def inspect_hole(
         result.diameter_m)  # fmt: skip
     delta = np.array(result.center_part_m) - nominal
     budget = combine(contributions, delta, normal_part, (ctx.part.note(),))
+    result = replace(result, extra={**result.extra, **gdt_extra(contributions, T_part_left)})
     return _decided(result, budget, ctx.rule), meas
 
 

@@ -1,9 +1,12 @@
 """The simulated stereo head: renders each capture from the simulator's truth.
 
 At the moment of the trigger it takes the controller's actual joints and the simulation time,
-computes the TRUE (thermally drifted) camera pose, finds the true hole or reference target in
+computes the TRUE camera pose (true base, D-H errors and thermal drift, true head:
+:class:`cell.sim.true_geometry.TrueGeometry`), finds the true hole or reference target in
 front of the head, and renders the pair with :func:`measure.synth.render_hole_pair` (a reference
 target with :func:`measure.synth.render_reference_pair`). A missing hole renders the bare surface.
+With no hole in view and the view axis on the calibration plate (at its true pose), it renders
+the plate with :func:`measure.synth.targets.render_target_pair`.
 """
 
 from __future__ import annotations
@@ -23,8 +26,9 @@ from cell.uncertainty.calibration import (
     perturbed,
 )
 from cell.uncertainty.repeatability import sigma_per_axis_m
-from measure import StereoCalibration, head_frame
+from measure import StereoCalibration
 from measure.synth import RenderOptions, render_hole_pair, render_reference_pair
+from measure.synth.targets import render_target_pair
 from robots.transforms import invert
 
 
@@ -40,6 +44,8 @@ def true_head(stereo: StereoCalibration, scale: float, seed: int) -> StereoCalib
 
 #: a feature counts as "in front of the head" within this distance of the view axis (m)
 VIEW_AXIS_TOL_M = 0.02
+#: the calibration plate is rendered when the view axis meets it this far from the head (m)
+TARGET_RANGE_M = (0.05, 1.0)
 
 
 @dataclass(frozen=True)
@@ -47,7 +53,7 @@ class CaptureTruth:
     """What was really in front of the head at a capture (for tests and the demo's error)."""
 
     feature_id: str | None
-    kind: str  # "hole", "reference", "missing" or "none"
+    kind: str  # "hole", "reference", "missing", "target" or "none"
     T_cell_left: np.ndarray
     center_cell_m: np.ndarray | None
     diameter_m: float | None
@@ -68,12 +74,13 @@ class SimCamera:
         self.world = world
         self.controller = controller
         self.stereo = stereo  # the calibration file: what the runner measures with
-        o = world.options
-        self.true_stereo = true_head(stereo, o.calibration_sigma_scale, o.seed)
-        self._rep_sigma_m = sigma_per_axis_m(o.repeatability_rp_m)
+        tr = world.truth
+        self.true_stereo = true_head(stereo, tr.calibration_sigma_scale, tr.seed)
+        self._rep_sigma_m = sigma_per_axis_m(tr.repeatability_rp_m)
+        self.geometry = world.true_geometry(stereo)
         self.missing = set(missing_holes)
         self.render = render or RenderOptions()
-        self._T_head_left = invert(head_frame(stereo))
+        self._T_head_left = self.geometry.T_tcp_left
         self._seed = seed
         self.captures = 0
         self.last_truth: CaptureTruth | None = None
@@ -90,15 +97,20 @@ class SimCamera:
     def _capture(self, t: float) -> StereoPair:
         T_cell_tcp = self.world.true_T_cell_tcp(self.controller.q_rad(), t)
         kind, feature = self._in_view(invert(T_cell_tcp @ self._T_head_left))
-        key = feature.id if feature is not None else "none"
+        s_target = self._target_distance(T_cell_tcp)
+        if s_target is not None and (feature is None or s_target < _depth(T_cell_tcp, feature)):
+            kind, feature = "target", None  # the plate is in front of whatever lies behind it
+        key = "calibration_target" if kind == "target" else feature.id if feature else "none"
         seed = (self._seed * 1_000_003 + zlib.crc32(key.encode())) & 0x7FFFFFFF
         if self._rep_sigma_m > 0:  # the arm's repeatability: this approach's scatter
-            rng = np.random.default_rng([self.world.options.seed, seed, self.captures])
+            rng = np.random.default_rng([self.world.truth.seed, seed, self.captures])
             T_cell_tcp = T_cell_tcp.copy()
             T_cell_tcp[:3, 3] += rng.normal(0.0, self._rep_sigma_m, 3)
         T_cell_left = T_cell_tcp @ self._T_head_left
         T_left_cell = invert(T_cell_left)
         self.captures += 1
+        if kind == "target":
+            return self._target_pair(T_cell_left, seed)
         if feature is None:  # bare surface facing the head, no hole anywhere near the view
             pair = render_hole_pair(self.true_stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
             self.last_truth = CaptureTruth(None, "none", T_cell_left, None, None)
@@ -114,6 +126,31 @@ class SimCamera:
             feature.id, kind, T_cell_left, feature.position_m.copy(), feature.diameter_m
         )
         return StereoPair(pair.left, pair.right)
+
+    def _target_distance(self, T_cell_tcp: np.ndarray) -> float | None:
+        """How far along the head's view axis it meets the calibration plate's printed face
+        from in front (m; the plate's true pose), or None: not within ``TARGET_RANGE_M``."""
+        T_cell_target = self.world.T_cell_target
+        if T_cell_target is None:
+            return None
+        T = invert(T_cell_target) @ T_cell_tcp  # the head in the board frame
+        o, d = T[:3, 3], T[:3, 2]
+        if not (o[2] < 0 < d[2]):  # the face is z = 0 and faces -z
+            return None
+        s = float(-o[2] / d[2])
+        lo, hi = self.world.cell.calibration_target.target_spec().plate_bounds()
+        p = o + s * d
+        inside = lo[0] <= p[0] <= hi[0] and lo[1] <= p[1] <= hi[1]
+        return s if inside and TARGET_RANGE_M[0] <= s <= TARGET_RANGE_M[1] else None
+
+    def _target_pair(self, T_cell_left: np.ndarray, seed: int) -> StereoPair:
+        """Render the calibration plate at its true pose in the true head."""
+        spec = self.world.cell.calibration_target.target_spec()
+        T_left_target = invert(T_cell_left) @ self.world.T_cell_target
+        r = render_target_pair(self.true_stereo, spec, T_left_target, supersample=1, seed=seed)
+        origin = self.world.T_cell_target[:3, 3].copy()
+        self.last_truth = CaptureTruth("calibration_target", "target", T_cell_left, origin, None)
+        return StereoPair(r.left, r.right)
 
     def _in_view(self, T_left_cell: np.ndarray) -> tuple[str, TrueHole | None]:
         T_head_cell = invert(self._T_head_left) @ T_left_cell
@@ -132,3 +169,8 @@ class SimCamera:
 
     def close(self) -> None:
         """Nothing to release."""
+
+
+def _depth(T_cell_head: np.ndarray, feature: TrueHole) -> float:
+    """Distance of ``feature`` along the head's view axis (m)."""
+    return float((invert(T_cell_head) @ np.append(feature.position_m, 1.0))[2])

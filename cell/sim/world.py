@@ -12,11 +12,16 @@ import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from cell.run.camera import cell_stereo
+from cell.sim.true_geometry import TrueGeometry
+from cell.sim.truth import CellTruth
+from measure import StereoCalibration, head_frame
 from robots.thermal.drift import DriftSettings, DriftTruth, default_settings
+from robots.transforms import invert
 
 
 class SimClock:
@@ -75,64 +80,76 @@ class TrueHole:
 
 @dataclass(frozen=True)
 class WorldOptions:
-    """Settings of the truth.
+    """Settings of the simulation; the cell's hidden errors are in ``truth``.
 
     Attributes:
         speed: simulation seconds per wall second (> 0).
         drift_offset_s: warm-up time already elapsed when the simulation starts (s).
         drift: the drift generator's settings (None: ``robots.thermal.drift.default_settings``).
-        position_sigma_m: standard deviation of each true hole centre from nominal, in the
-            surface plane (m): the part as machined.
-        diameter_sigma_m: standard deviation of each true diameter from nominal (m).
-        seed: seed of the part errors and the sensor noise.
-        repeatability_rp_m: the arm's ISO 9283 pose repeatability RP (m): every capture's TCP
-            position scatters isotropically by ``RP / 3.616`` per axis (0: none).
-        calibration_sigma_scale: the true stereo head differs from its calibration file by a
-            draw of this many times the file's stated (or the default) uncertainties (0: the
-            file is exact).
-        part_temperature_c: the part's true temperature (degC); it expands about the part frame
-            origin from its 20 degC geometry by ``part_alpha_per_K``.
+        truth: every hidden error of the cell (:class:`cell.sim.truth.CellTruth`: D-H, base,
+            head, part placement, target placement, the part as machined, repeatability, the
+            head's calibration error, the part's temperature, the seed of every draw); default
+            :meth:`CellTruth.zero`.
         part_alpha_per_K: the part's true expansion coefficient (None: the cell's material
-            figure).
+            figure); the part expands about its true frame's origin.
         part_thermometer_sigma_K: standard deviation of a part temperature reading (K).
     """
 
     speed: float = 1.0
     drift_offset_s: float = 1800.0
     drift: DriftSettings | None = None
-    position_sigma_m: float = 15e-6
-    diameter_sigma_m: float = 5e-6
-    seed: int = 0
-    repeatability_rp_m: float = 0.0
-    calibration_sigma_scale: float = 0.0
-    part_temperature_c: float = 20.0
+    truth: CellTruth = field(default_factory=CellTruth.zero)
     part_alpha_per_K: float | None = None  # noqa: N815 (unit suffix)
     part_thermometer_sigma_K: float = 0.0  # noqa: N815 (unit suffix)
 
+    @property
+    def seed(self) -> int:
+        """The truth's seed: the part errors, the sensor noise, the head's draw."""
+        return self.truth.seed
+
 
 class SimWorld:
-    """The truth of one simulated cell: built from a :class:`cell.config.CellConfig`."""
+    """The truth of one simulated cell: built from a :class:`cell.config.CellConfig`.
+
+    The true kinematics are the nominal D-H table plus ``truth.dh_errors`` under the thermal
+    drift; the true base, head and part are the nominal poses composed with the truth's errors;
+    the true holes are the nominal ones carried by the true part frame, then off by the part's
+    machining scatter."""
 
     def __init__(self, cell, options: WorldOptions | None = None) -> None:
         self.options = options or WorldOptions()
+        self.truth = self.options.truth
         self.clock = SimClock(self.options.speed)
         self.cell = cell
         self.arm = cell.build_arm()
-        self.T_cell_base = np.asarray(cell.T_cell_base(), dtype=float)
-        self.T_tool0_tcp = np.asarray(cell.T_tool0_tcp(), dtype=float)
+        tr = self.truth
+        self.T_cell_base = np.asarray(cell.T_cell_base(), dtype=float) @ tr.base_error
+        self.T_tool0_tcp = np.asarray(cell.T_tool0_tcp(), dtype=float) @ tr.tcp_error
+        self.T_cell_part = np.asarray(cell.T_cell_part(), dtype=float) @ tr.part_placement_error
+        target = cell.calibration_target
+        self.T_cell_target = (None if target is None
+                              else target.T_cell_target() @ tr.target_placement_error)  # fmt: skip
         settings = self.options.drift or default_settings()
-        self.drift = DriftTruth(self.arm.dh, settings, seed=self.options.seed)
-        self.holes = self._true_holes(np.random.default_rng(self.options.seed))
+        self.drift = DriftTruth(tr.table(self.arm.dh), settings, seed=tr.seed)
+        self.holes = self._true_holes(np.random.default_rng(tr.seed))
         o = self.options
         self.part_alpha_per_K = (cell.part_material()[0].alpha_per_K
                                  if o.part_alpha_per_K is None else o.part_alpha_per_K)  # fmt: skip
         self.holes_at_temperature = self._expanded(self.holes)
 
+    def true_geometry(self, stereo: StereoCalibration | None = None) -> TrueGeometry:
+        """The true frames (for the simulated head and benchmarks; never for the runner);
+        ``stereo`` places the left camera in the head (None: the cell's calibration)."""
+        stereo = stereo if stereo is not None else cell_stereo(self.cell)
+        return TrueGeometry(self.drift.table, self.drift, self.options.drift_offset_s,
+                            self.T_cell_base, self.T_tool0_tcp, invert(head_frame(stereo)),
+                            self.T_cell_part, self.T_cell_target)  # fmt: skip
+
     def _expanded(self, holes: dict[str, TrueHole]) -> dict[str, TrueHole]:
         """The true holes as they are at the part's temperature: the 20 degC geometry expanded
-        about the part frame origin (cell frame, m)."""
-        s = 1.0 + self.part_alpha_per_K * (self.options.part_temperature_c - 20.0)
-        T = np.asarray(self.cell.T_cell_part(), float)
+        about the true part frame origin (cell frame, m)."""
+        s = 1.0 + self.part_alpha_per_K * (self.truth.part_temperature_c - 20.0)
+        T = self.T_cell_part
         out = {}
         for k, h in holes.items():
             p_part = T[:3, :3].T @ (h.position_m - T[:3, 3])
@@ -141,22 +158,25 @@ class SimWorld:
 
     def part_reading_c(self) -> float:
         """A reading of the part's temperature (degC): the truth plus the thermometer's noise."""
-        rng = np.random.default_rng([self.options.seed, 0x7A27])
-        return float(self.options.part_temperature_c
+        rng = np.random.default_rng([self.truth.seed, 0x7A27])
+        return float(self.truth.part_temperature_c
                      + rng.normal(0.0, self.options.part_thermometer_sigma_K))  # fmt: skip
 
     def _true_holes(self, rng: np.random.Generator) -> dict[str, TrueHole]:
         out: dict[str, TrueHole] = {}
-        for h in self.cell.holes_in_cell():
-            n = np.asarray(h.normal, dtype=float)
+        T = self.T_cell_part
+        for h in self.cell.part.holes:
+            # the machining process aims at the middle of a hole's size limits (cell.gdt)
+            size = None if h.tolerances is None else h.tolerances.size
+            mid = 0.0 if size is None else (size.upper_m + size.lower_m) / 2.0
+            p = T[:3, :3] @ np.array(h.position) + T[:3, 3]
+            n = T[:3, :3] @ np.array(h.normal)
             u = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
             u /= np.linalg.norm(u)
             v = np.cross(n, u)
-            du, dv = rng.normal(0.0, self.options.position_sigma_m, 2)
-            dd = rng.normal(0.0, self.options.diameter_sigma_m)
-            out[h.id] = TrueHole(
-                h.id, np.asarray(h.position_m, float) + du * u + dv * v, n, h.diameter_m + dd
-            )
+            du, dv = rng.normal(0.0, self.truth.hole_position_sigma_m, 2)
+            dd = mid + rng.normal(0.0, self.truth.hole_diameter_sigma_m)
+            out[h.id] = TrueHole(h.id, p + du * u + dv * v, n, h.diameter + dd)
         return out
 
     def temperatures(self, t_s: float) -> np.ndarray:

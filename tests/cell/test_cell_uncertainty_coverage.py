@@ -19,6 +19,7 @@ from cell.run.camera import cell_stereo
 from cell.run.demo import truth_error
 from cell.run.inspect import inspect_hole
 from cell.sim.camera import SimCamera
+from cell.sim.truth import CellTruth
 from cell.sim.world import SimWorld, WorldOptions
 from cell.uncertainty.context import budget_context
 from cell.uncertainty.part_temperature import part_state
@@ -40,8 +41,9 @@ def _run(sc: SmallCell, seed: int):
     rp, _ = repeatability_rp_m(cell.robot.model, None)
     mat, _ = cell.part_material()
     alpha = mat.alpha_per_K + np.random.default_rng(seed).normal(0.0, mat.u_alpha_per_K)
-    opts = WorldOptions(drift=steady_drift(), seed=seed, repeatability_rp_m=rp,
-                        calibration_sigma_scale=1.0, part_temperature_c=24.0,
+    truth = replace(CellTruth.zero(seed), repeatability_rp_m=rp, calibration_sigma_scale=1.0,
+                    part_temperature_c=24.0)  # fmt: skip
+    opts = WorldOptions(drift=steady_drift(), truth=truth,
                         part_alpha_per_K=alpha, part_thermometer_sigma_K=0.1)  # fmt: skip
     world = SimWorld(cell, opts)
     ctrl = _Arm()
