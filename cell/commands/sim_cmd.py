@@ -39,6 +39,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
     p.add_argument("--transport", choices=("pty", "socket"), default="pty")
     p.add_argument(
+        "--controller",
+        choices=("python", "rapid"),
+        default="python",
+        help="python: the Python stand-in; rapid: the shipped RAPID module in the interpreter",
+    )
+    p.add_argument(
         "--speed", type=positive_float, default=1.0, help="simulation speed (x real time, > 0)"
     )
     p.add_argument(
@@ -91,7 +97,7 @@ def run_sim(args: argparse.Namespace) -> int:
     truth = (CellTruth.zero(args.seed) if args.truth is None
              else CellTruth.load(args.truth, cell, seed=args.seed))  # fmt: skip
     world = WorldOptions(speed=args.speed, drift_offset_s=args.drift_offset_s, truth=truth)
-    with SimCell.start(cell, world, faults, args.transport) as sim:
+    with SimCell.start(cell, world, faults, args.transport, controller=args.controller) as sim:
         cam = CameraServer(sim.camera).start()
         try:
             print(f"controller  {sim.url}", flush=True)
@@ -100,6 +106,8 @@ def run_sim(args: argparse.Namespace) -> int:
             t_end = None if args.duration_s is None else time.monotonic() + args.duration_s
             while t_end is None or time.monotonic() < t_end:
                 time.sleep(0.2)
+                if getattr(sim.controller, "error", None) is not None:  # the RAPID program
+                    raise CellError(f"controller stopped: {sim.controller.error}")
         finally:
             cam.close()
     return 0

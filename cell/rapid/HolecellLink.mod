@@ -5,9 +5,14 @@ MODULE HolecellLink
   ! (cell.link.frame, cell.link.messages); tests/cell/test_cell_rapid.py checks
   ! that they are equal and that the CRC-32 routine reproduces zlib.crc32.
   !
-  ! Runs in the motion task: PROC hcMain. Needs RobotWare 6 (dnum bit functions),
-  ! the serial channel configured as "com1:" (115200 8N1, no flow control) and
-  ! six analog inputs aiTempJ1 .. aiTempJ6 (link temperatures, degC).
+  ! Runs in the motion task: PROC hcMain. Needs RobotWare 6 (dnum bit functions)
+  ! or RobotWare 7, and six analog inputs aiTempJ1 .. aiTempJ6 (link
+  ! temperatures, degC). The link (HC_TRANSPORT below):
+  !   "serial": the serial channel configured as "com1:" (115200 8N1, no flow
+  !             control); IRC5 only (OmniCore has no serial channel for RAPID);
+  !   "socket": RAPID socket messaging, this controller a TCP server on
+  !             HC_SOCKET_ADDRESS:HC_SOCKET_PORT; IRC5 needs RobotWare option
+  !             616-1 PC Interface or 672-1 Socket Messaging; RobotWare 7 has it.
   ! Units on the wire: joints int32 micro-degrees, temperatures int32 milli-degC.
   !*****************************************************************************
 
@@ -64,10 +69,29 @@ MODULE HolecellLink
   CONST num HC_ROW_STEP := 10;
   CONST num HC_LINK_TIMEOUT_S := 1;
   CONST num HC_ON_PATH_TOL_DEG := 0.001;
+  CONST num HC_IN_POS_TOL_DEG := 0.001;
   CONST num HC_N_TEMPS := 6;
 
+  ! --- transport: "serial" (the channel HC_PORT) or "socket" (RAPID socket
+  ! messaging, this controller the server on HC_SOCKET_ADDRESS:HC_SOCKET_PORT).
+  ! Serial needs a configured serial channel; socket needs option 616-1 PC
+  ! Interface or 672-1 Socket Messaging on IRC5 (RobotWare 6), and is part of
+  ! RobotWare 7 (OmniCore). Only hcLinkOpen, hcLinkRead and hcLinkWrite differ.
+  CONST string HC_TRANSPORT := "serial";
+  CONST string HC_SOCKET_ADDRESS := "192.168.125.1";
+  CONST num HC_SOCKET_PORT := 1025;
+  CONST num HC_POLL_S := 0.002;
+  ! longest wait for the rest of a frame on the serial channel (520 bytes take
+  ! 45 ms at 115200 baud); a frame cut short is dropped and retransmitted
+  CONST num HC_FRAME_S := 0.1;
+
   VAR iodev hcChan;
+  VAR socketdev hcServer;
+  VAR socketdev hcClient;
+  VAR bool hcConnected := FALSE;
+  VAR rawbytes hcRxChunk;
   VAR clock hcClock;
+  VAR clock hcLinkClock;
   VAR dnum hcCrcTable{256};
   ! receive state machine
   VAR num hcRxState := 0;
@@ -83,9 +107,14 @@ MODULE HolecellLink
   VAR dnum hcLastCrc := 0;
   VAR rawbytes hcLastAnswer;
   VAR rawbytes hcAns;
-  VAR num hcLastRx := 0;
-  ! trajectory (degrees) and motion state
+  ! trajectory (degrees), stop rows (1-based), load progress and motion state.
+  ! The trajectory id is the CRC-32 of the rows and stops as they arrive on the
+  ! wire (int32/uint32): a num keeps integers exact only up to 8388608, so
+  ! micro-degrees rebuilt from num degrees would differ past 8.4 deg.
   VAR num hcRows{HC_MAX_ROWS, 6};
+  VAR num hcRowsIn := 0;
+  VAR num hcStopsIn := 0;
+  VAR dnum hcLoadCrc := 0;
   VAR num hcStops{HC_MAX_STOPS};
   VAR num hcNRows := 0;
   VAR num hcNStops := 0;
@@ -112,21 +141,20 @@ MODULE HolecellLink
   ENDPROC
 
   PROC hcInit()
-    Close hcChan;
-    Open HC_PORT, hcChan \Bin;
-    ClearIOBuff hcChan;
+    hcLinkOpen;
     hcCrcInit;
     ClkReset hcClock;
     ClkStart hcClock;
-    AliasIO "aiTempJ1", hcTemp{1};
-    AliasIO "aiTempJ2", hcTemp{2};
-    AliasIO "aiTempJ3", hcTemp{3};
-    AliasIO "aiTempJ4", hcTemp{4};
-    AliasIO "aiTempJ5", hcTemp{5};
-    AliasIO "aiTempJ6", hcTemp{6};
+    ClkReset hcLinkClock;
+    ClkStart hcLinkClock;
+    FOR i FROM 1 TO HC_N_TEMPS DO
+      AliasIO "aiTempJ" + NumToStr(i, 0), hcTemp{i};
+    ENDFOR
     IF hcEstopLatched THEN
       hcState := ST_ESTOP;
       hcFault := FLT_ESTOP;
+      hcAtStop := -1;
+      hcTargetStop := -1;
     ENDIF
   ENDPROC
 
@@ -156,6 +184,8 @@ MODULE HolecellLink
     VAR num b;
     VAR dnum c;
     c := crc;
+    ! a FOR without STEP counts down when FROM > TO: no loop for count 0
+    IF count < 1 RETURN c;
     FOR i FROM first TO first + count - 1 DO
       UnpackRawBytes raw, i, b \IntX:=USINT;
       c := hcCrcByte(c, b);
@@ -163,28 +193,113 @@ MODULE HolecellLink
     RETURN c;
   ENDFUNC
 
+  ! --- transport ---------------------------------------------------------------
+  PROC hcLinkOpen()
+    IF HC_TRANSPORT = "socket" THEN
+      SocketClose hcClient;
+      SocketClose hcServer;
+      hcConnected := FALSE;
+      SocketCreate hcServer;
+      SocketBind hcServer, HC_SOCKET_ADDRESS, HC_SOCKET_PORT;
+      SocketListen hcServer;
+    ELSE
+      Close hcChan;
+      Open HC_PORT, hcChan \Bin;
+      ClearIOBuff hcChan;
+    ENDIF
+  ENDPROC
+
+  ! Bytes received, in hcRxChunk; their number (0: none). Socket: what arrives
+  ! within HC_POLL_S; serial: one byte within HC_POLL_S, or the "want" bytes of
+  ! a frame's rest within HC_FRAME_S (else the frame is dropped).
+  ! A socket client is accepted first; a closed one is dropped (the watchdog
+  ! stops the arm) and the next one accepted.
+  FUNC num hcLinkRead(num want)
+    ClearRawBytes hcRxChunk;
+    IF HC_TRANSPORT = "socket" THEN
+      IF NOT hcConnected THEN
+        SocketAccept hcServer, hcClient \Time:=HC_POLL_S;
+        hcConnected := TRUE;
+        hcRxState := 0;
+      ENDIF
+      SocketReceive hcClient \RawData:=hcRxChunk \Time:=HC_POLL_S;
+    ELSEIF want = 1 THEN
+      PackRawBytes ReadBin(hcChan \Time:=HC_POLL_S), hcRxChunk, 1 \IntX:=USINT;
+    ELSE
+      ReadRawBytes hcChan, hcRxChunk, want \Time:=HC_FRAME_S;
+    ENDIF
+    RETURN RawBytesLen(hcRxChunk);
+  ERROR
+    IF ERRNO = ERR_DEV_MAXTIME OR ERRNO = ERR_SOCK_TIMEOUT THEN
+      IF want > 1 hcRxState := 0;
+      RETURN 0;
+    ELSEIF ERRNO = ERR_SOCK_CLOSED THEN
+      SocketClose hcClient;
+      hcConnected := FALSE;
+      RETURN 0;
+    ENDIF
+    RAISE;
+  ENDFUNC
+
+  PROC hcLinkWrite(VAR rawbytes f)
+    IF HC_TRANSPORT = "socket" THEN
+      IF hcConnected SocketSend hcClient \RawData:=f;
+    ELSE
+      WriteRawBytes hcChan, f;
+    ENDIF
+  ERROR
+    IF ERRNO = ERR_SOCK_CLOSED THEN
+      SocketClose hcClient;
+      hcConnected := FALSE;
+      RETURN;
+    ENDIF
+    RAISE;
+  ENDPROC
+
   ! --- receiving ---------------------------------------------------------------
   ! Byte-wise state machine. Unlike the Python decoder it does not rescan the
   ! bytes of a rejected frame; a frame swallowed that way is recovered by the
   ! host's retransmission.
   PROC hcPollLine()
-    VAR num b;
-    b := hcReadByte();
-    WHILE b >= 0 DO
-      hcRxByte b;
-      b := hcReadByte();
+    VAR num n;
+    n := hcLinkRead(hcRxWant());
+    WHILE n > 0 DO
+      hcRxBytes n;
+      n := hcLinkRead(hcRxWant());
     ENDWHILE
   ENDPROC
 
-  FUNC num hcReadByte()
-    RETURN ReadBin(hcChan \Time:=0.002);
-  ERROR
-    IF ERRNO = ERR_DEV_MAXTIME THEN
-      RETURN -1;
-    ENDIF
-    RAISE;
+  ! bytes the receiver needs next: the rest of a header or of a payload and CRC
+  FUNC num hcRxWant()
+    IF hcRxState = 2 RETURN 4 - hcRxCount;
+    IF hcRxState = 3 RETURN hcRxLen + 4 - hcRxCount;
+    RETURN 1;
   ENDFUNC
 
+  ! the n bytes of hcRxChunk: sync and header byte by byte, payload in one copy
+  PROC hcRxBytes(num n)
+    VAR num i := 1;
+    VAR num b;
+    VAR num k;
+    WHILE i <= n DO
+      IF hcRxState = 3 THEN
+        k := Min(n - i + 1, hcRxLen + 4 - hcRxCount);
+        CopyRawBytes hcRxChunk, i, hcRxPay, hcRxCount + 1 \NoOfBytes:=k;
+        hcRxCount := hcRxCount + k;
+        i := i + k;
+        IF hcRxCount = hcRxLen + 4 THEN
+          hcRxState := 0;
+          hcFrameDone;
+        ENDIF
+      ELSE
+        UnpackRawBytes hcRxChunk, i, b \IntX:=USINT;
+        hcRxByte b;
+        i := i + 1;
+      ENDIF
+    ENDWHILE
+  ENDPROC
+
+  ! sync and header (states 0 to 2); state 3 (payload) is hcRxBytes'
   PROC hcRxByte(num b)
     TEST hcRxState
     CASE 0:
@@ -213,13 +328,6 @@ MODULE HolecellLink
           hcRxState := 3;
         ENDIF
       ENDIF
-    CASE 3:
-      hcRxCount := hcRxCount + 1;
-      PackRawBytes b, hcRxPay, hcRxCount \IntX:=USINT;
-      IF hcRxCount = hcRxLen + 4 THEN
-        hcRxState := 0;
-        hcFrameDone;
-      ENDIF
     ENDTEST
   ENDPROC
 
@@ -232,9 +340,9 @@ MODULE HolecellLink
       hcSendNak HC_SEQ_UNKNOWN, NAK_CRC, "bad CRC";
       RETURN;
     ENDIF
-    hcLastRx := ClkRead(hcClock);
+    ClkReset hcLinkClock;
     IF hcRxType <> MSG_IDENTIFY AND hcRxSeq = hcLastSeq AND crc = hcLastCrc THEN
-      WriteRawBytes hcChan, hcLastAnswer;
+      hcLinkWrite hcLastAnswer;
       RETURN;
     ENDIF
     hcLastSeq := hcRxSeq;
@@ -256,7 +364,7 @@ MODULE HolecellLink
     IF n > 0 CopyRawBytes pay, 1, f, 7 \NoOfBytes:=n;
     crc := BitXOrDnum(hcCrcRaw(HC_CRC32_INIT, f, 3, n + 4), HC_CRC32_INIT);
     PackRawBytes crc, f, n + 7 \IntX:=UDINT;
-    WriteRawBytes hcChan, f;
+    hcLinkWrite f;
     ClearRawBytes hcLastAnswer;
     CopyRawBytes f, 1, hcLastAnswer, 1;
   ENDPROC
@@ -301,16 +409,20 @@ MODULE HolecellLink
     CASE MSG_MOVE_TO_STOP:
       hcMoveToStop;
     CASE MSG_STOP:
-      hcHalt ST_STOPPED, FLT_NONE;
+      ! a latched emergency stop or fault stays until RESET
+      IF hcState = ST_MOVING hcHalt ST_STOPPED, FLT_NONE;
       hcAck;
     CASE MSG_ABORT:
-      hcHalt ST_IDLE, FLT_NONE;
+      IF hcState = ST_MOVING hcHalt ST_STOPPED, FLT_NONE;
       hcLoaded := FALSE;
       hcTrajId := 0;
+      hcAtStop := -1;
+      IF hcState <> ST_ESTOP AND hcState <> ST_FAULT hcState := ST_IDLE;
       hcAck;
     CASE MSG_RESET:
       IF hcState = ST_ESTOP OR hcState = ST_FAULT THEN
-        hcState := ST_STOPPED;
+        hcState := ST_IDLE;
+        IF hcLoaded hcState := ST_STOPPED;
       ENDIF
       hcEstopLatched := FALSE;
       hcFault := FLT_NONE;
@@ -318,6 +430,13 @@ MODULE HolecellLink
     DEFAULT:
       hcSendNak hcRxSeq, NAK_UNKNOWN_TYPE, "unknown message type";
     ENDTEST
+  ERROR
+    ! a payload shorter than its message needs: read past its valid bytes
+    IF ERRNO = ERR_OUTOFBND THEN
+      hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "payload too short";
+      RETURN;
+    ENDIF
+    RAISE;
   ENDPROC
 
   PROC hcStatus()
@@ -329,13 +448,13 @@ MODULE HolecellLink
     PackRawBytes hcTargetStop, hcAns, 5 \IntX:=INT;
     PackRawBytes hcPos - 1, hcAns, 7 \IntX:=UDINT;
     PackRawBytes hcTrajId, hcAns, 11 \IntX:=UDINT;
-    PackRawBytes NumToDnum(Round(ClkRead(hcClock) * 1000) * 1000), hcAns, 15 \IntX:=LINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_1 * 1000000)), hcAns, 23 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_2 * 1000000)), hcAns, 27 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_3 * 1000000)), hcAns, 31 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_4 * 1000000)), hcAns, 35 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_5 * 1000000)), hcAns, 39 \IntX:=DINT;
-    PackRawBytes NumToDnum(Round(j.robax.rax_6 * 1000000)), hcAns, 43 \IntX:=DINT;
+    PackRawBytes NumToDnum(Round(ClkRead(hcClock) * 1000)) * 1000, hcAns, 15 \IntX:=LINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_1) * 1000000), hcAns, 23 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_2) * 1000000), hcAns, 27 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_3) * 1000000), hcAns, 31 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_4) * 1000000), hcAns, 35 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_5) * 1000000), hcAns, 39 \IntX:=DINT;
+    PackRawBytes Round(NumToDnum(j.robax.rax_6) * 1000000), hcAns, 43 \IntX:=DINT;
     PackRawBytes HC_N_TEMPS, hcAns, 47 \IntX:=USINT;
     FOR i FROM 1 TO HC_N_TEMPS DO
       PackRawBytes Round(AInput(hcTemp{i}) * 1000), hcAns, 44 + 4 * i \IntX:=DINT;
@@ -368,6 +487,9 @@ MODULE HolecellLink
     ENDIF
     hcLoaded := FALSE;
     hcLoadId := id;
+    hcRowsIn := 0;
+    hcStopsIn := 0;
+    hcLoadCrc := HC_CRC32_INIT;
     hcNRows := rows;
     hcNStops := stops;
     hcDt := dtUs / 1000000;
@@ -385,12 +507,23 @@ MODULE HolecellLink
       hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "rows out of range";
       RETURN;
     ENDIF
+    IF first + count <= hcRowsIn THEN
+      ! rows already held (a repeated chunk)
+      hcAck;
+      RETURN;
+    ENDIF
+    IF first <> hcRowsIn THEN
+      hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "rows out of order";
+      RETURN;
+    ENDIF
     FOR r FROM 1 TO count DO
       FOR a FROM 1 TO 6 DO
         UnpackRawBytes hcRxPay, 6 + 24 * (r - 1) + 4 * (a - 1), v \IntX:=DINT;
-        hcRows{first + r, a} := DnumToNum(v) / 1000000;
+        hcRows{first + r, a} := DnumToNum(v / 1000000);
       ENDFOR
     ENDFOR
+    hcLoadCrc := hcCrcRaw(hcLoadCrc, hcRxPay, 6, 24 * count);
+    hcRowsIn := first + count;
     hcAck;
   ENDPROC
 
@@ -404,10 +537,24 @@ MODULE HolecellLink
       hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "stops out of range";
       RETURN;
     ENDIF
+    IF first + count <= hcStopsIn THEN
+      hcAck;
+      RETURN;
+    ENDIF
+    IF first <> hcStopsIn OR hcRowsIn < hcNRows THEN
+      hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "stops out of order or before the rows";
+      RETURN;
+    ENDIF
     FOR s FROM 1 TO count DO
       UnpackRawBytes hcRxPay, 4 + 4 * (s - 1), row \IntX:=UDINT;
+      IF row >= hcNRows THEN
+        hcSendNak hcRxSeq, NAK_BAD_PAYLOAD, "stop row beyond the rows";
+        RETURN;
+      ENDIF
       hcStops{first + s} := row + 1;
     ENDFOR
+    hcLoadCrc := hcCrcRaw(hcLoadCrc, hcRxPay, 4, 4 * count);
+    hcStopsIn := first + count;
     hcAck;
   ENDPROC
 
@@ -415,6 +562,10 @@ MODULE HolecellLink
     VAR dnum id;
     VAR num row;
     UnpackRawBytes hcRxPay, 1, id \IntX:=UDINT;
+    IF hcRowsIn < hcNRows OR hcStopsIn < hcNStops THEN
+      hcSendNak hcRxSeq, NAK_REFUSED, "rows or stops missing";
+      RETURN;
+    ENDIF
     IF id <> hcLoadId OR id <> hcTrajectoryId() THEN
       hcSendNak hcRxSeq, NAK_REFUSED, "trajectory id does not match the data";
       RETURN;
@@ -430,30 +581,21 @@ MODULE HolecellLink
     hcLoaded := TRUE;
     hcPos := row;
     hcAtStop := -1;
-    FOR s FROM 1 TO hcNStops DO
-      IF hcStops{s} = row AND hcAtStop < 0 hcAtStop := s - 1;
-    ENDFOR
+    IF hcNStops > 0 THEN
+      FOR s FROM 1 TO hcNStops DO
+        IF hcStops{s} = row AND hcAtStop < 0 hcAtStop := s - 1;
+      ENDFOR
+    ENDIF
     hcState := ST_IDLE;
     IF hcAtStop >= 0 hcState := ST_IN_POSITION;
     hcAck;
   ENDPROC
 
-  ! CRC-32 of the rows (int32 LE micro-degrees) followed by the stop rows (u32 LE)
+  ! CRC-32 of the rows (int32 LE micro-degrees) followed by the stop rows (u32 LE),
+  ! accumulated over the payloads as they arrived (hcLoadRows, hcLoadStops)
   FUNC dnum hcTrajectoryId()
-    VAR rawbytes b;
     VAR dnum c;
-    c := HC_CRC32_INIT;
-    FOR r FROM 1 TO hcNRows DO
-      FOR a FROM 1 TO 6 DO
-        PackRawBytes NumToDnum(Round(hcRows{r, a} * 1000000)), b, 1 \IntX:=DINT;
-        c := hcCrcRaw(c, b, 1, 4);
-      ENDFOR
-    ENDFOR
-    FOR s FROM 1 TO hcNStops DO
-      PackRawBytes hcStops{s} - 1, b, 1 \IntX:=UDINT;
-      c := hcCrcRaw(c, b, 1, 4);
-    ENDFOR
-    c := BitXOrDnum(c, HC_CRC32_INIT);
+    c := BitXOrDnum(hcLoadCrc, HC_CRC32_INIT);
     IF c = 0 c := 1;
     RETURN c;
   ENDFUNC
@@ -500,11 +642,21 @@ MODULE HolecellLink
 
   ! One via-point per call: every HC_ROW_STEP-th row with a zone, timed with \T
   ! so the motion keeps the planner's timing; the target row as a fine point.
+  ! Every move is \Conc (the program keeps serving the link: a STOP waits for
+  ! at most one queued move); in position once the arm is at the target row.
   PROC hcMotionStep()
     VAR num next;
     VAR num dir;
     VAR jointtarget jt;
     IF hcState <> ST_MOVING RETURN;
+    IF hcPos = hcTargetRow THEN
+      IF hcArmAtRow(hcTargetRow) THEN
+        hcAtStop := hcTargetStop;
+        hcTargetStop := -1;
+        hcState := ST_IN_POSITION;
+      ENDIF
+      RETURN;
+    ENDIF
     dir := 1;
     IF hcTargetRow < hcPos dir := -1;
     next := hcPos + dir * HC_ROW_STEP;
@@ -513,16 +665,24 @@ MODULE HolecellLink
     jt.robax := [hcRows{next, 1}, hcRows{next, 2}, hcRows{next, 3},
                  hcRows{next, 4}, hcRows{next, 5}, hcRows{next, 6}];
     IF next = hcTargetRow THEN
-      MoveAbsJ jt \NoEOffs, v1000 \T:=Abs(next - hcPos) * hcDt, fine, tool0;
-      hcPos := next;
-      hcAtStop := hcTargetStop;
-      hcTargetStop := -1;
-      hcState := ST_IN_POSITION;
+      MoveAbsJ \Conc, jt \NoEOffs, v1000 \T:=Abs(next - hcPos) * hcDt, fine, tool0;
     ELSE
       MoveAbsJ \Conc, jt \NoEOffs, v1000 \T:=HC_ROW_STEP * hcDt, z5, tool0;
-      hcPos := next;
     ENDIF
+    hcPos := next;
   ENDPROC
+
+  ! whether every joint is within HC_IN_POS_TOL_DEG of row r
+  FUNC bool hcArmAtRow(num r)
+    VAR jointtarget j;
+    j := CJointT();
+    RETURN Abs(hcRows{r, 1} - j.robax.rax_1) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 2} - j.robax.rax_2) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 3} - j.robax.rax_3) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 4} - j.robax.rax_4) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 5} - j.robax.rax_5) <= HC_IN_POS_TOL_DEG
+       AND Abs(hcRows{r, 6} - j.robax.rax_6) <= HC_IN_POS_TOL_DEG;
+  ENDFUNC
 
   PROC hcHalt(num state, num fault)
     IF hcState = ST_MOVING THEN
@@ -537,7 +697,8 @@ MODULE HolecellLink
     hcAtStop := -1;
   ENDPROC
 
-  ! the row nearest the arm's joints among the last via-points issued
+  ! the row nearest the arm's joints among the last via-points issued (at most
+  ! five concurrent moves and the final one are queued)
   FUNC num hcNearestRow(num around)
     VAR jointtarget j;
     VAR num best;
@@ -545,7 +706,7 @@ MODULE HolecellLink
     VAR num e;
     j := CJointT();
     best := around;
-    FOR r FROM Max(1, around - 5 * HC_ROW_STEP) TO Min(hcNRows, around + 5 * HC_ROW_STEP) DO
+    FOR r FROM Max(1, around - 6 * HC_ROW_STEP) TO Min(hcNRows, around + 6 * HC_ROW_STEP) DO
       e := Abs(hcRows{r, 1} - j.robax.rax_1) + Abs(hcRows{r, 2} - j.robax.rax_2)
            + Abs(hcRows{r, 3} - j.robax.rax_3) + Abs(hcRows{r, 4} - j.robax.rax_4)
            + Abs(hcRows{r, 5} - j.robax.rax_5) + Abs(hcRows{r, 6} - j.robax.rax_6);
@@ -558,7 +719,7 @@ MODULE HolecellLink
   ENDFUNC
 
   PROC hcWatchdog()
-    IF hcState = ST_MOVING AND ClkRead(hcClock) - hcLastRx > HC_LINK_TIMEOUT_S THEN
+    IF hcState = ST_MOVING AND ClkRead(hcLinkClock) > HC_LINK_TIMEOUT_S THEN
       hcHalt ST_STOPPED, FLT_LINK_LOST;
     ENDIF
   ENDPROC

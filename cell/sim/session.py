@@ -36,10 +36,17 @@ class SimCell:
         transport: str = "pty",
         link_timeout_s: float = 1.0,
         render: RenderOptions | None = None,
+        controller: str = "python",
     ) -> SimCell:
-        """Build and start the simulated cell."""
+        """Build and start the simulated cell. ``controller`` "python" serves
+        :class:`SimController`; "rapid" the shipped RAPID module in the interpreter
+        (:class:`cell.sim.rapid_controller.RapidController`)."""
         faults = faults or FaultPlan()
         w = SimWorld(cell, world)
+        if controller == "rapid":
+            return cls._start_rapid(cell, w, faults, transport, link_timeout_s, render)
+        if controller != "python":
+            raise ValueError(f"controller {controller!r} must be 'python' or 'rapid'")
         ctrl = SimController(
             w.clock,
             w.temperatures,
@@ -55,6 +62,19 @@ class SimCell:
             server.close()
             raise
         return cls(w, ctrl, server, cam)
+
+    @classmethod
+    def _start_rapid(cls, cell, w, faults, transport, link_timeout_s, render) -> SimCell:
+        from cell.sim.rapid_controller import RapidController
+
+        ctrl = RapidController(w.clock, w.temperatures, cell.robot.model, cell.home_q(), faults,
+                               transport, faults.estop_at_stop, link_timeout_s).start()  # fmt: skip
+        try:
+            cam = SimCamera(w, ctrl, cell_stereo(cell), faults.missing_holes, render, faults.seed)
+        except BaseException:
+            ctrl.close()
+            raise
+        return cls(w, ctrl, ctrl, cam)
 
     @property
     def url(self) -> str:

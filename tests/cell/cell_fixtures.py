@@ -49,3 +49,25 @@ def small_cell(tmp_path_factory: pytest.TempPathFactory) -> SmallCell:
 def steady_drift() -> DriftSettings:
     """An arm that does not warm up and sensors without noise: runs repeat bit for bit."""
     return DriftSettings.per_joint(("steel",) * 6, (WarmUp(0.0, 100.0),) * 6)
+
+
+@pytest.fixture(params=["python", "rapid"])
+def controller(request: pytest.FixtureRequest) -> str:
+    """The simulated controller: the Python stand-in or the shipped RAPID module interpreted."""
+    return request.param
+
+
+@pytest.fixture(params=["python", pytest.param("rapid", marks=pytest.mark.slow)])
+def controller_rapid_slow(request: pytest.FixtureRequest) -> str:
+    """As ``controller``, the interpreted module only with ``-m slow`` (a long test)."""
+    return request.param
+
+
+def link_for(controller: str, options):
+    """The test's link options; against the interpreted module a response timeout of at least
+    the client's default (it answers a full LOAD_ROWS frame in tens of ms)."""
+    from dataclasses import replace
+
+    if controller != "rapid":
+        return options
+    return replace(options, response_timeout_s=max(options.response_timeout_s, 0.15))

@@ -1,4 +1,5 @@
-"""The link client against the simulated controller over a pty and a socket, with faults."""
+"""The link client against the simulated controller over a pty and a socket, with faults: the
+Python stand-in (``python``) and the shipped RAPID module in the interpreter (``rapid``)."""
 
 from __future__ import annotations
 
@@ -12,11 +13,19 @@ from cell.link.client import ControllerClient, LinkOptions
 from cell.link.errors import LinkError, RequestRefusedError
 from cell.sim.controller import SimController
 from cell.sim.faults import FaultPlan
+from cell.sim.rapid_controller import RapidController
 from cell.sim.server import SimServer
 from cell.sim.world import SimClock
 
 HOME = np.array([0.0, -0.3, 0.4, 0.0, 0.5, 0.0])
 FAST = LinkOptions(response_timeout_s=0.03, retries=40, heartbeat_period_s=0.05)
+#: the interpreted module answers a full LOAD_ROWS frame in tens of ms (a real serial line at
+#: 115200 baud needs 45 ms to carry one): the client's default response timeout
+FAST_RAPID = LinkOptions(response_timeout_s=0.15, retries=40, heartbeat_period_s=0.05)
+
+
+def _fast(controller: str) -> LinkOptions:
+    return FAST_RAPID if controller == "rapid" else FAST
 
 
 def _trajectory(n: int = 200) -> tuple[np.ndarray, list[int]]:
@@ -25,16 +34,27 @@ def _trajectory(n: int = 200) -> tuple[np.ndarray, list[int]]:
     return out, [50, 100, 150]
 
 
-def _server(faults: FaultPlan | None = None, transport: str = "pty", **kw) -> SimServer:
+@pytest.fixture(params=["python", "rapid"])
+def controller(request) -> str:
+    return request.param
+
+
+def _server(controller: str, faults: FaultPlan | None = None, transport: str = "pty", **kw):
     temps = lambda t: np.array([20.0 + 0.01 * t, 21.0])  # noqa: E731
-    ctrl = SimController(SimClock(kw.pop("speed", 50.0)), temps, "abb_test", HOME, **kw)
+    clock = SimClock(kw.pop("speed", 50.0))
+    if controller == "rapid":
+        return RapidController(clock, temps, "abb_test", HOME, faults, transport, **kw).start()
+    ctrl = SimController(clock, temps, "abb_test", HOME, **kw)
     return SimServer(ctrl, faults, transport).start()
 
 
 @pytest.mark.parametrize("transport", ["pty", "socket"])
-def test_identify_load_move_and_status(transport: str) -> None:
+def test_identify_load_move_and_status(transport: str, controller: str) -> None:
     q, stops = _trajectory()
-    with _server(transport=transport) as sim, ControllerClient(sim.url, FAST) as c:
+    with (
+        _server(controller, transport=transport) as sim,
+        ControllerClient(sim.url, _fast(controller)) as c,
+    ):
         assert c.identity.robot_model == "abb_test" and c.identity.version == m.PROTOCOL_VERSION
         traj_id = c.load_trajectory(q, stops, 0.004)
         assert c.load_trajectory(q, stops, 0.004) == traj_id  # already loaded: no transfer
@@ -49,9 +69,9 @@ def test_identify_load_move_and_status(transport: str) -> None:
         assert st.temperatures_c.shape == (2,) and st.traj_id == traj_id
 
 
-def test_moves_backwards_along_the_path_and_stop_holds() -> None:
+def test_moves_backwards_along_the_path_and_stop_holds(controller: str) -> None:
     q, stops = _trajectory()
-    with _server(speed=5.0) as sim, ControllerClient(sim.url, FAST) as c:
+    with _server(controller, speed=5.0) as sim, ControllerClient(sim.url, _fast(controller)) as c:
         c.load_trajectory(q, stops, 0.004)
         c.move_to_stop(2)
         time.sleep(0.08)
@@ -63,10 +83,10 @@ def test_moves_backwards_along_the_path_and_stop_holds() -> None:
         np.testing.assert_allclose(st.q_rad, q[stops[0]], atol=1e-7)
 
 
-def test_faulty_line_still_delivers_every_request_once() -> None:
+def test_faulty_line_still_delivers_every_request_once(controller: str) -> None:
     q, stops = _trajectory(600)
     faults = FaultPlan(drop=0.05, corrupt=0.05, delay=0.05, delay_s=0.04, seed=3)
-    with _server(faults) as sim, ControllerClient(sim.url, FAST) as c:
+    with _server(controller, faults) as sim, ControllerClient(sim.url, _fast(controller)) as c:
         c.load_trajectory(q, stops, 0.004)
         for k in range(len(stops)):
             c.move_to_stop(k)
@@ -75,9 +95,12 @@ def test_faulty_line_still_delivers_every_request_once() -> None:
         assert c.stats.retransmits > 0
 
 
-def test_estop_latches_until_reset() -> None:
+def test_estop_latches_until_reset(controller: str) -> None:
     q, stops = _trajectory()
-    with _server(estop_at_stop=1) as sim, ControllerClient(sim.url, FAST) as c:
+    with (
+        _server(controller, estop_at_stop=1) as sim,
+        ControllerClient(sim.url, _fast(controller)) as c,
+    ):
         c.load_trajectory(q, stops, 0.004)
         c.move_to_stop(1)
         st = c.wait_in_position(1, timeout_s=5.0)
@@ -89,24 +112,26 @@ def test_estop_latches_until_reset() -> None:
         assert c.wait_in_position(1, timeout_s=5.0).state == m.State.IN_POSITION
 
 
-def test_link_loss_stops_the_arm_on_the_path() -> None:
-    q, _ = _trajectory(2000)
-    with _server(speed=1.0, link_timeout_s=0.1) as sim:
+def test_link_loss_stops_the_arm_on_the_path(controller: str) -> None:
+    # the interpreted module loads 2000 rows in seconds: 600 (2.2 s of motion) are enough there
+    n = 600 if controller == "rapid" else 2000
+    q, _ = _trajectory(n)
+    with _server(controller, speed=1.0, link_timeout_s=0.1) as sim:
         c = ControllerClient(sim.url, LinkOptions(response_timeout_s=0.03, heartbeat_period_s=60))
         c.connect()
-        c.load_trajectory(q, [1900], 0.004)
+        c.load_trajectory(q, [n - 50], 0.004)
         c.move_to_stop(0)
         c._stop_hb.set()
         time.sleep(0.3)
         st = c.status()
         assert st.state == m.State.STOPPED and st.fault == m.Fault.LINK_LOST
-        assert 0 < st.row < 1900
+        assert 0 < st.row < n - 50
         c.close()
 
 
-def test_socket_disconnect_then_reconnect() -> None:
+def test_socket_disconnect_then_reconnect(controller: str) -> None:
     faults = FaultPlan(disconnect_after=5, disconnect_s=0.2)
-    with _server(faults, transport="socket") as sim:
+    with _server(controller, faults, transport="socket") as sim:
         c = ControllerClient(sim.url, LinkOptions(response_timeout_s=0.03, retries=3))
         c.connect()
         with pytest.raises(LinkError):

@@ -107,3 +107,19 @@ def test_rapid_crc_routine_reproduces_zlib() -> None:
         for b in data:
             crc = env["hcCrcByte"](crc, b)
         assert crc ^ C["HC_CRC32_INIT"] == zlib.crc32(data)
+
+
+def test_module_crc_in_the_interpreter_reproduces_zlib() -> None:
+    """The module's own hcCrcInit and hcCrcRaw, run by the RAPID interpreter (num in single
+    precision, dnum in double), give zlib's CRC-32."""
+    from cell.rapid.interp import Program
+    from cell.rapid.interp.rtypes import RawBytes
+
+    program = Program.from_file(MOD)
+    program.run("hcCrcInit", host=None)
+    rng = random.Random(1)
+    for data in [b"123456789", b"", *(rng.randbytes(rng.randrange(1, 300)) for _ in range(5))]:
+        raw = RawBytes()
+        raw.data[: len(data)], raw.n = data, len(data)
+        crc = program.call("hcCrcRaw", C["HC_CRC32_INIT"], raw, 1, len(data))
+        assert int(crc) ^ C["HC_CRC32_INIT"] == zlib.crc32(data)

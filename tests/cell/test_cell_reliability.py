@@ -12,7 +12,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-from cell_fixtures import SmallCell, steady_drift
+import pytest
+from cell_fixtures import SmallCell, link_for, steady_drift
 
 from cell.link.client import ControllerClient, LinkOptions
 from cell.review.store import Store, count_measurements
@@ -20,13 +21,15 @@ from cell.run.runner import Runner, RunOptions
 from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
+from cell.sim.rapid_controller import RapidController
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
 
 
 def _inprocess_run(sc: SmallCell, run_dir: Path, sim: SimCell, link: LinkOptions):
     files = start_run(run_dir, sc.cell, sc.tour, "tour.json", sim.url)
-    client = ControllerClient(sim.url, link)
+    ctrl = "rapid" if isinstance(sim.controller, RapidController) else "python"
+    client = ControllerClient(sim.url, link_for(ctrl, link))
     client.connect()
     options = RunOptions(settle_s=0.0, reference_rounds=0, reconnect_budget_s=10.0)
     try:
@@ -37,11 +40,15 @@ def _inprocess_run(sc: SmallCell, run_dir: Path, sim: SimCell, link: LinkOptions
         files.store.close()
 
 
-def test_dropped_corrupted_frames_and_a_disconnect(small_cell: SmallCell, tmp_path: Path) -> None:
+@pytest.mark.parametrize("transport", ["pty", "socket"])
+def test_dropped_corrupted_frames_and_a_disconnect(
+    small_cell: SmallCell, tmp_path: Path, controller: str, transport: str
+) -> None:
     faults = FaultPlan(drop=0.05, corrupt=0.02, disconnect_after=50, disconnect_s=1.5, seed=7)
     link = LinkOptions(response_timeout_s=0.04, retries=8, heartbeat_period_s=0.1)
     world = WorldOptions(speed=20.0, drift=steady_drift())
-    with SimCell.start(small_cell.cell, world, faults) as sim:
+    with SimCell.start(small_cell.cell, world, faults, transport,
+                       controller=controller) as sim:  # fmt: skip
         result, stored, events = _inprocess_run(small_cell, tmp_path, sim, link)
         server = sim.server
     assert result.status == "done"
@@ -59,14 +66,19 @@ def _holecell(*args: str) -> subprocess.Popen:
     return subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
 
 
-def test_killed_runner_resumes_to_the_same_store(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_killed_runner_resumes_to_the_same_store(
+    small_cell: SmallCell, tmp_path: Path, controller_rapid_slow: str
+) -> None:
     world = WorldOptions(speed=20.0, drift=steady_drift())
     link = LinkOptions(response_timeout_s=0.05)
-    with SimCell.start(small_cell.cell, world) as sim:
+    with SimCell.start(small_cell.cell, world, controller=controller_rapid_slow) as sim:
         clean, reference, _ = _inprocess_run(small_cell, tmp_path / "uninterrupted", sim, link)
     rng = random.Random(int(os.environ.get("HOLECELL_KILL_SEED", "3")))
     run_dir = tmp_path / "killed"
-    with SimCell.start(small_cell.cell, world) as sim, CameraServer(sim.camera).start() as cam:
+    with (
+        SimCell.start(small_cell.cell, world, controller=controller_rapid_slow) as sim,
+        CameraServer(sim.camera).start() as cam,
+    ):
         common = ["--port", sim.url, "--camera", cam.url, "--settle-s", "0", "--quiet"]
         first = _holecell(
             "run",

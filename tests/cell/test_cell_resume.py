@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from cell_fixtures import SmallCell
+from cell_fixtures import SmallCell, link_for
 
 from cell.cli import main
 from cell.link.client import ControllerClient, LinkOptions
@@ -16,6 +16,7 @@ from cell.run.runner import RunFaultError, Runner, RunOptions
 from cell.run.setup import resume_run, start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
+from cell.sim.rapid_controller import RapidController
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
 
@@ -30,7 +31,8 @@ def _runner(sc: SmallCell, run_dir: Path, sim: SimCell, resume: bool, progress=N
         files = resume_run(run_dir)
     else:
         files = start_run(run_dir, sc.cell, sc.tour, "tour.json", sim.url, sc.reference)
-    client = ControllerClient(sim.url, FAST_LINK)
+    ctrl = "rapid" if isinstance(sim.controller, RapidController) else "python"
+    client = ControllerClient(sim.url, link_for(ctrl, FAST_LINK))
     client.connect()
     options = RunOptions(settle_s=0.0, reconnect_budget_s=5.0,  # default reference rounds
                          part_temperature_c=part_c)  # fmt: skip
@@ -48,10 +50,10 @@ def _estop_while_inspecting(sim: SimCell):
 
 
 def test_resume_after_estop_at_a_hole_with_default_reference_rounds(
-    small_cell: SmallCell, tmp_path: Path
+    small_cell: SmallCell, tmp_path: Path, controller_rapid_slow: str
 ) -> None:
     assert RunOptions().reference_rounds > 0
-    with SimCell.start(small_cell.cell, WORLD) as sim:
+    with SimCell.start(small_cell.cell, WORLD, controller=controller_rapid_slow) as sim:
         runner, files, client = _runner(small_cell, tmp_path, sim, False,
                                         _estop_while_inspecting(sim), part_c=24.5)  # fmt: skip
         try:
@@ -60,7 +62,7 @@ def test_resume_after_estop_at_a_hole_with_default_reference_rounds(
         finally:
             client.close()
             files.store.close()
-        with ControllerClient(sim.url, FAST_LINK) as operator:
+        with ControllerClient(sim.url, link_for(controller_rapid_slow, FAST_LINK)) as operator:
             operator.reset()
         runner, files, client = _runner(small_cell, tmp_path, sim, True)
         try:
@@ -89,10 +91,12 @@ def _cli(sc: SmallCell, sim: SimCell, cam: CameraServer, run_dir: Path, *extra: 
 
 
 def test_cli_refuses_a_latched_estop_and_reset_clears_it(
-    small_cell: SmallCell, tmp_path: Path, capsys
+    small_cell: SmallCell, tmp_path: Path, capsys, controller: str
 ) -> None:
     run = tmp_path / "run"
-    with SimCell.start(small_cell.cell, WORLD, FaultPlan(estop_at_stop=1)) as sim:
+    with SimCell.start(
+        small_cell.cell, WORLD, FaultPlan(estop_at_stop=1), controller=controller
+    ) as sim:
         cam = CameraServer(sim.camera).start()
         try:
             assert _cli(small_cell, sim, cam, run, "--reference-rounds", "0", "--yes") == 2

@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 import pytest
-from cell_fixtures import SmallCell, steady_drift
+from cell_fixtures import SmallCell, link_for, steady_drift
 
 from cell.cli import main
 from cell.link import messages as m
@@ -18,6 +18,7 @@ from cell.run.camera import CameraError
 from cell.run.runner import RunFaultError, Runner, RunOptions
 from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
+from cell.sim.rapid_controller import RapidController
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
 
@@ -40,7 +41,8 @@ def _fail_on_capture(sim: SimCell, n_ok: int) -> None:
 
 def _run(sc: SmallCell, run_dir: Path, sim: SimCell, progress=None) -> None:
     files = start_run(run_dir, sc.cell, sc.tour, "tour.json", sim.url)
-    client = ControllerClient(sim.url, FAST_LINK)
+    ctrl = "rapid" if isinstance(sim.controller, RapidController) else "python"
+    client = ControllerClient(sim.url, link_for(ctrl, FAST_LINK))
     client.connect()
     options = RunOptions(settle_s=0.0, reference_rounds=0)
     try:
@@ -57,8 +59,10 @@ def _state(run_dir: Path) -> tuple[str, str, int]:
         return info["state"], events[-1]["message"], len(store.stored_ids())
 
 
-def test_camera_error_leaves_a_fault_record(small_cell: SmallCell, tmp_path: Path) -> None:
-    with SimCell.start(small_cell.cell, WORLD) as sim:
+def test_camera_error_leaves_a_fault_record(
+    small_cell: SmallCell, tmp_path: Path, controller: str
+) -> None:
+    with SimCell.start(small_cell.cell, WORLD, controller=controller) as sim:
         _fail_on_capture(sim, 1)
         with pytest.raises(CameraError):
             _run(small_cell, tmp_path, sim)
@@ -68,21 +72,27 @@ def test_camera_error_leaves_a_fault_record(small_cell: SmallCell, tmp_path: Pat
     assert n_stored == 1
 
 
-def test_interrupt_stops_the_run(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_interrupt_stops_the_run(
+    small_cell: SmallCell, tmp_path: Path, controller_rapid_slow: str
+) -> None:
     def progress(event: str, data: dict) -> None:
         if event == "hole":
             raise KeyboardInterrupt
 
-    with SimCell.start(small_cell.cell, WORLD) as sim, pytest.raises(KeyboardInterrupt):
+    with (
+        SimCell.start(small_cell.cell, WORLD, controller=controller_rapid_slow) as sim,
+        pytest.raises(KeyboardInterrupt),
+    ):
         _run(small_cell, tmp_path, sim, progress)
     state, message, n_stored = _state(tmp_path)
     assert state == "stopped" and "interrupted" in message and n_stored == 1
 
 
-def test_cli_writes_the_report_of_a_failed_run(small_cell: SmallCell, tmp_path: Path,
-                                               capsys) -> None:  # fmt: skip
+def test_cli_writes_the_report_of_a_failed_run(
+    small_cell: SmallCell, tmp_path: Path, capsys, controller_rapid_slow: str
+) -> None:
     run = tmp_path / "run"
-    with SimCell.start(small_cell.cell, WORLD) as sim:
+    with SimCell.start(small_cell.cell, WORLD, controller=controller_rapid_slow) as sim:
         _fail_on_capture(sim, 1)
         with CameraServer(sim.camera).start() as cam:
             code = main(["run", str(small_cell.tour_path), "--cell", str(small_cell.path),
@@ -104,12 +114,17 @@ def test_cli_refuses_negative_numbers(small_cell: SmallCell, capsys, option, val
     assert exc.value.code == 2 and option in capsys.readouterr().err
 
 
-def test_move_timeout_is_a_fault_not_a_dead_link(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_move_timeout_is_a_fault_not_a_dead_link(
+    small_cell: SmallCell, tmp_path: Path, controller: str
+) -> None:
     """A slow arm (the simulation at a tenth of real time) misses the move timeout: the run
     stops the arm and faults at once, without reconnecting or reloading the trajectory."""
     files = start_run(tmp_path, small_cell.cell, small_cell.tour, "tour.json", "sim")
     slow = WorldOptions(speed=0.1, drift=steady_drift())
-    with SimCell.start(small_cell.cell, slow) as sim, ControllerClient(sim.url, FAST_LINK) as c:
+    with (
+        SimCell.start(small_cell.cell, slow, controller=controller) as sim,
+        ControllerClient(sim.url, link_for(controller, FAST_LINK)) as c,
+    ):
         options = RunOptions(settle_s=0.0, reference_rounds=0, move_timeout_s=0.3)
         runner = Runner(files.cell, files.tour, files.store, c, sim.camera, options)
         try:

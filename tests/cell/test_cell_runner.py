@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cell_fixtures import SmallCell, steady_drift
+from cell_fixtures import SmallCell, link_for, steady_drift
 
 from cell.link.client import ControllerClient, LinkOptions
 from cell.review.store import Store
@@ -16,6 +16,7 @@ from cell.run.demo import truth_error
 from cell.run.runner import RunFaultError, Runner, RunOptions
 from cell.run.setup import TourMismatchError, resume_run, start_run
 from cell.sim.faults import FaultPlan
+from cell.sim.rapid_controller import RapidController
 from cell.sim.session import SimCell
 from cell.sim.world import WorldOptions
 
@@ -23,12 +24,13 @@ FAST_LINK = LinkOptions(response_timeout_s=0.05, retries=20, heartbeat_period_s=
 
 
 def _run(sc: SmallCell, run_dir: Path, sim: SimCell, resume: bool = False, **opts):
+    ctrl = "rapid" if isinstance(sim.controller, RapidController) else "python"
     files = (
         resume_run(run_dir)
         if resume
         else start_run(run_dir, sc.cell, sc.tour, "tour.json", sim.url, sc.reference)
     )
-    client = ControllerClient(sim.url, FAST_LINK)
+    client = ControllerClient(sim.url, link_for(ctrl, FAST_LINK))
     client.connect()
     options = RunOptions(
         settle_s=0.0,
@@ -46,9 +48,11 @@ def _run(sc: SmallCell, run_dir: Path, sim: SimCell, resume: bool = False, **opt
         files.store.close()  # fmt: skip
 
 
-def test_every_hole_measured_once_and_accurately(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_every_hole_measured_once_and_accurately(
+    small_cell: SmallCell, tmp_path: Path, controller: str
+) -> None:
     world = WorldOptions(speed=20.0, drift=steady_drift())
-    with SimCell.start(small_cell.cell, world) as sim:
+    with SimCell.start(small_cell.cell, world, controller=controller) as sim:
         result, stored, events = _run(small_cell, tmp_path, sim)
         err = truth_error(sim.world, stored)
     assert result.status == "done"
@@ -59,15 +63,19 @@ def test_every_hole_measured_once_and_accurately(small_cell: SmallCell, tmp_path
     assert states == ["waiting", "inspecting", "homing", "done"]
 
 
-def test_thermal_update_from_reference_rounds(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_thermal_update_from_reference_rounds(
+    small_cell: SmallCell, tmp_path: Path, controller_rapid_slow: str
+) -> None:
     # the clock runs fast from the reference phase on, not while the run is set up: at 1500x a
     # few tenths of a second of set-up (under load) were minutes of warm-up before the cold state
     # is read, an offset of the reference temperatures no reference observation can see
     world = WorldOptions(speed=1.0, drift_offset_s=0.0)
-    with SimCell.start(small_cell.cell, world) as sim:
+    with SimCell.start(small_cell.cell, world, controller=controller_rapid_slow) as sim:
 
         def fast_from_reference(event: str, data: dict) -> None:
-            if event == "state" and data.get("state") == "reference":
+            # from the first round on: the cold state is read once the reference tour is
+            # loaded, which takes the interpreted module seconds (hours at 1500x)
+            if event == "round" and data.get("round") == 0:
                 sim.world.clock.set_speed(1500.0)
 
         result, stored, _ = _run(small_cell, tmp_path, sim, rounds=3, progress=fast_from_reference)
@@ -76,11 +84,13 @@ def test_thermal_update_from_reference_rounds(small_cell: SmallCell, tmp_path: P
     assert err.rms_m < 0.2 * err.rms_uncompensated_m
 
 
-def test_missing_hole_is_recorded_not_measured(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_missing_hole_is_recorded_not_measured(
+    small_cell: SmallCell, tmp_path: Path, controller_rapid_slow: str
+) -> None:
     gone = small_cell.tour.hole_order[1]
     faults = FaultPlan(missing_holes=(gone,))
     world = WorldOptions(speed=20.0, drift=steady_drift())
-    with SimCell.start(small_cell.cell, world, faults) as sim:
+    with SimCell.start(small_cell.cell, world, faults, controller=controller_rapid_slow) as sim:
         _, stored, _ = _run(small_cell, tmp_path, sim)
     by_id = {r.hole_id: r for r in stored}
     assert by_id[gone].status == "missing" and by_id[gone].center_part_m is None
@@ -88,28 +98,36 @@ def test_missing_hole_is_recorded_not_measured(small_cell: SmallCell, tmp_path: 
     assert sum(r.status == "ok" for r in stored) == len(stored) - 1
 
 
-def test_estop_stops_the_run_and_resume_completes(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_estop_stops_the_run_and_resume_completes(
+    small_cell: SmallCell, tmp_path: Path, controller: str
+) -> None:
     faults = FaultPlan(estop_at_stop=1)
-    with SimCell.start(small_cell.cell, WorldOptions(speed=20.0), faults) as sim:
+    with SimCell.start(
+        small_cell.cell, WorldOptions(speed=20.0), faults, controller=controller
+    ) as sim:
         with pytest.raises(RunFaultError, match="ESTOP"):
             _run(small_cell, tmp_path, sim)
         with Store.open(tmp_path) as store:
             assert store.stored_ids() == {small_cell.tour.hole_order[0]}
             assert store.run_info()["state"] == "fault"
-        with ControllerClient(sim.url, FAST_LINK) as operator:
+        with ControllerClient(sim.url, link_for(controller, FAST_LINK)) as operator:
             operator.reset()  # the fault is cleared at the cell
         result, stored, _ = _run(small_cell, tmp_path, sim, resume=True)
     assert result.skipped == [small_cell.tour.hole_order[0]]
     assert [r.hole_id for r in stored] == small_cell.tour.hole_order
 
 
-def test_estop_during_the_reference_rounds_resumes(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_estop_during_the_reference_rounds_resumes(
+    small_cell: SmallCell, tmp_path: Path, controller_rapid_slow: str
+) -> None:
     # the arm stops on the reference trajectory: the resumed run goes home along that one
     faults = FaultPlan(estop_at_stop=1)
-    with SimCell.start(small_cell.cell, WorldOptions(speed=20.0), faults) as sim:
+    with SimCell.start(
+        small_cell.cell, WorldOptions(speed=20.0), faults, controller=controller_rapid_slow
+    ) as sim:
         with pytest.raises(RunFaultError, match="reference"):
             _run(small_cell, tmp_path, sim, rounds=2)
-        with ControllerClient(sim.url, FAST_LINK) as operator:
+        with ControllerClient(sim.url, link_for(controller_rapid_slow, FAST_LINK)) as operator:
             operator.reset()
         sim.controller.estop_at_stop = None
         result, stored, events = _run(small_cell, tmp_path, sim, resume=True, rounds=2)
@@ -155,10 +173,16 @@ def test_cli_refuses_truncated_tour_and_corrupt_store(
     assert (run / "results.sqlite").read_bytes() == b"\x00garbage" * 500
 
 
-def test_stored_result_matches_report(small_cell: SmallCell, tmp_path: Path) -> None:
+def test_stored_result_matches_report(
+    small_cell: SmallCell, tmp_path: Path, controller_rapid_slow: str
+) -> None:
     from cell.review.report import write_report
 
-    with SimCell.start(small_cell.cell, WorldOptions(speed=20.0, drift=steady_drift())) as sim:
+    with SimCell.start(
+        small_cell.cell,
+        WorldOptions(speed=20.0, drift=steady_drift()),
+        controller=controller_rapid_slow,
+    ) as sim:
         _, stored, _ = _run(small_cell, tmp_path, sim)
     summ = write_report(tmp_path)
     doc = json.loads((tmp_path / "report.json").read_text())
