@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robots.dh import DHTable, dh_table
+from robots.dh import DHTable
+from robots.dh_models import dh_table
 from robots.models import MODELS
 from robots.thermal import (
     CellGeometry,
