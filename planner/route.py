@@ -7,12 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from planner.protocols import ArmLike
 from planner.segments import Segment
 from planner.timing import TimedMotion
-from planner.tour import Stop
+from planner.tour import Stop, pose_dict
 from planner.trajectory import Dwell
 from planner.viewpoints import HoleCandidates
 
@@ -42,10 +41,7 @@ def route_stops(
             break
         q = route.q[k]
         T = arm.fk(q, "tcp")
-        pose = {
-            "xyz": [float(v) for v in T[:3, 3]],
-            "quat_xyzw": [float(v) for v in Rotation.from_matrix(T[:3, :3]).as_quat()],
-        }
+        pose = pose_dict(T)
         stops.append(
             Stop(
                 route.hole_ids[k],
