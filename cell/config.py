@@ -11,13 +11,13 @@ with the file name, the field path and the value.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import yaml
 from pydantic import ValidationError
 
 from cell.config_checks import cell_problems
 from cell.config_pose import IDENTITY, UNIT_TOL, Pose, Positive, Vec3
+from cell.config_problems import pydantic_problems
 from cell.config_schema import (
     PART_TEMPERATURE_RANGE_C,
     CalibrationTarget,
@@ -72,28 +72,6 @@ DATA_DIR = Path(__file__).parent / "data"
 BUILTIN_CELLS = ("motorcycle_frame",)
 
 
-def _field_path(loc: tuple[Any, ...]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        elif part in ("function-after[_unit(), list[float]]",):
-            continue
-        else:
-            out += f".{part}" if out else str(part)
-    return out or "(top level)"
-
-
-def _pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
-    problems = []
-    for err in exc.errors():
-        msg = err["msg"].removeprefix("Value error, ")
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key"
-        problems.append((_field_path(err["loc"]), err.get("input"), msg))
-    return problems
-
-
 def _with_csv_holes(
     cfg: CellConfig, source: str, source_path: Path | None, text: str
 ) -> CellConfig:
@@ -110,7 +88,7 @@ def _with_csv_holes(
     try:
         extra = [Hole.model_validate(r) for r in rows]
     except ValidationError as exc:
-        raise ConfigError(str(csv_path), _pydantic_problems(exc)) from exc
+        raise ConfigError(str(csv_path), pydantic_problems(exc)) from exc
     part = cfg.part.model_copy(update={"holes": [*cfg.part.holes, *extra]})
     out = cfg.model_copy(update={"part": part})
     out._source_path = source_path
@@ -129,7 +107,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
     try:
         cfg = CellConfig.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(source, _pydantic_problems(exc)) from exc
+        raise ConfigError(source, pydantic_problems(exc)) from exc
     cfg._source_path = source_path
     cfg._raw_text = text
     if cfg.part.holes_csv is not None:
