@@ -142,6 +142,22 @@ def test_relative_and_from_imports_resolve(tmp_path: Path) -> None:
     assert imports_of("cell.sub.x", source, modules) == {"cell.config"}
 
 
+def test_a_package_init_counts_only_when_taken_from(tmp_path: Path) -> None:
+    """``pkg/__init__`` re-exporting ``pkg.a`` is no circle with ``pkg.a`` importing its
+    sibling ``pkg.b``; it is one when ``pkg.a`` takes a name from ``pkg`` itself."""
+    (tmp_path / "init.py").write_text("from pkg.a import f\n")
+    (tmp_path / "a_sibling.py").write_text("from pkg.b import g\n")
+    (tmp_path / "a_from_init.py").write_text("from pkg import g\n")
+    (tmp_path / "b.py").write_text("g = 1\n")
+    modules = {"pkg": tmp_path / "init.py", "pkg.a": tmp_path / "a.py", "pkg.b": tmp_path / "b.py"}
+    init = imports_of("pkg", tmp_path / "init.py", modules)
+    b = imports_of("pkg.b", tmp_path / "b.py", modules)
+    sibling = {"pkg": init, "pkg.a": imports_of("pkg.a", tmp_path / "a_sibling.py", modules)}
+    assert import_cycles({**sibling, "pkg.b": b}) == []
+    taken = {"pkg": init, "pkg.a": imports_of("pkg.a", tmp_path / "a_from_init.py", modules)}
+    assert import_cycles({**taken, "pkg.b": b}) == [["pkg", "pkg.a"]]
+
+
 def test_no_import_cycles() -> None:
     graph = import_graph()
     cycles = import_cycles(graph)
