@@ -1,5 +1,6 @@
-"""Validation errors of the YAML files (cell file, truth file) as ``(field path, value,
-message)`` problems, the form of :class:`cell.errors.ConfigError`."""
+"""Validation errors of the cell file as ``(field path, value, message)`` problems, the form
+of :class:`cell.errors.ConfigError`. (``cell/sim/truth_file.py`` has its own copy, being
+reworked on another branch; to be made one with this after that lands.)"""
 
 from __future__ import annotations
 

@@ -9,13 +9,12 @@ field's path. Lengths in m, angles in rad, temperatures in degC.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from cell.config import PART_TEMPERATURE_RANGE_C, Pose
-from cell.config_problems import pydantic_problems
 from cell.errors import TruthFileError
 
 #: the truth file's format tag (optional in a file; written first)
@@ -101,6 +100,16 @@ class TruthSpec(_Strict):
     stereo: StereoTruth = StereoTruth()
 
 
+def _field_path(loc: tuple[Any, ...]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += f".{part}" if out else str(part)
+    return out or "(top level)"
+
+
 def parse_truth_spec(text: str, source: str) -> TruthSpec:
     """Validate a truth file's YAML text; raises :class:`TruthFileError` naming each field."""
     try:
@@ -114,7 +123,13 @@ def parse_truth_spec(text: str, source: str) -> TruthSpec:
     try:
         return TruthSpec.model_validate(data)
     except ValidationError as exc:
-        raise TruthFileError(source, pydantic_problems(exc)) from exc
+        problems = []
+        for err in exc.errors():
+            msg = err["msg"].removeprefix("Value error, ")
+            if err["type"] == "extra_forbidden":
+                msg = "unknown key"
+            problems.append((_field_path(err["loc"]), err.get("input"), msg))
+        raise TruthFileError(source, problems) from exc
 
 
 def read_truth_spec(path: str | Path) -> TruthSpec:
