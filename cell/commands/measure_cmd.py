@@ -4,25 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-import cv2
 import numpy as np
 
 from measure import MeasureOptions, StereoCalibration, measure_hole
 from measure.errors import ImageError, MeasurementError
+from measure.image_input import read_image
 
-
-def read_image(path: str, which: str) -> np.ndarray:
-    """Read an 8- or 16-bit image as single-channel (colour is converted to gray)."""
-    if not Path(path).is_file():
-        raise ImageError(which, f"{path}: no such file")
-    img = cv2.imread(path, cv2.IMREAD_UNCHANGED)
-    if img is None:
-        raise ImageError(which, f"{path}: not a readable image")
-    if img.ndim == 3:
-        img = cv2.cvtColor(img[:, :, :3], cv2.COLOR_BGR2GRAY)
-    return img
+__all__ = ["read_image", "register", "run"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:

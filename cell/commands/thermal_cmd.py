@@ -20,7 +20,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robots.dh import DHTable, dh_table
+from cell.commands.group_help import help_handler
+from robots.dh import DHTable
+from robots.dh_models import dh_table
 from robots.models import MODELS
 from robots.thermal import (
     CellGeometry,
@@ -61,7 +63,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Temperature error compensation on the D-H model of the arm.",
     )
     sub = p.add_subparsers(dest="thermal_command", metavar="STEP")
-    p.set_defaults(handler=lambda args: _help(p))
+    p.set_defaults(handler=help_handler(p))
     ident = sub.add_parser(
         "identify",
         help="fit the thermal model to reference-target observations",
@@ -129,11 +131,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     from cell.commands import thermal_plan_cmd
 
     thermal_plan_cmd.register(sub)
-
-
-def _help(parser: argparse.ArgumentParser) -> int:
-    parser.print_help()
-    return 2
 
 
 def _table_of(cfg: CellConfig) -> DHTable:
