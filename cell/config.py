@@ -31,6 +31,7 @@ from cell.uncertainty.materials import (
     MaterialSpec,
     material_field,
 )
+from cell.yaml_problem import yaml_problem
 from robots import DEFAULT_MODEL, Arm, LimitScaling, Shape
 from robots.transforms import pose_to_matrix
 
@@ -418,7 +419,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        raise ConfigError(source, [("(yaml)", None, f"not valid YAML: {exc}")]) from exc
+        raise ConfigError(source, [yaml_problem(exc)]) from None
     if not isinstance(data, dict):
         raise ConfigError(source, [("(top level)", data, "a cell file is a mapping of keys")])
     try:

@@ -20,7 +20,8 @@ Per hole, under ``tolerances`` (a hole's ``position`` is its nominal centre alre
 and ``size: {upper_m, lower_m}`` (deviations from the nominal diameter, m, as the drawing
 writes them: H8 on 10 mm is ``{upper_m: 2.2e-5, lower_m: 0}``). The older single
 ``tolerance`` keeps working (see docs/gdt.md); a hole carries either it or ``tolerances``,
-never both.
+never both. Figures too large to be metres (millimetres typed unchanged) are refused by
+:mod:`cell.gdt.plausible`.
 
 ``part.alignment`` picks the run's alignment (the frame of the placement and of holes
 without a position tolerance): ``{datums: [A, B, C]}`` or
@@ -33,6 +34,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
+
+from cell.gdt.plausible import size_problems
 
 if TYPE_CHECKING:
     from cell.config import CellConfig
@@ -163,7 +166,9 @@ def gdt_problems(cfg: CellConfig) -> list[Problem]:
         seen.add(d.label)
         problems += _datum_problems(where, d, holes)
     for i, h in enumerate(cfg.part.holes):
-        problems += _hole_problems(f"part.holes[{i}]", h, datums)
+        problems += size_problems(f"part.holes[{i}]", h) + _hole_problems(
+            f"part.holes[{i}]", h, datums
+        )
     a = cfg.part.alignment
     if a is not None and a.datums is not None:
         problems += _frame_problems("part.alignment.datums", a.datums, datums)
