@@ -31,3 +31,19 @@ def test_the_summary_line() -> None:
     )
     d = {"orientations": 5, "min_rotation_between_orientations_rad": np.radians(21.04)}
     assert orientation_line(d, 5) == "orientations  5 distinct, at least 21.0 deg apart"
+
+
+@pytest.mark.slow  # 8 s of planning; the two tests above hold the figures and the line
+def test_plan_calibration_prints_the_orientations(tmp_path, capsys) -> None:
+    from cell.cli import main
+    from planner.calibration import load_caltour
+
+    out = tmp_path / "caltour.json"
+    args = ["plan-calibration", "-o", str(out), "--views", "5", "--criterion", "geometric"]
+    assert main([*args, "--quiet"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    d = load_caltour(out).design
+    assert d["orientations"] == 5  # the geometric design keeps views >= 20 deg apart
+    assert d["min_rotation_between_orientations_rad"] == pytest.approx(d["min_rotation_rad"])
+    want = f"orientations  5 distinct, at least {np.degrees(d['min_rotation_rad']):.1f} deg apart"
+    assert want in lines and not any("smallest rotation" in s for s in lines)
