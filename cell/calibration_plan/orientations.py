@@ -18,13 +18,13 @@ SAME_ORIENTATION_RAD = np.radians(1.0)
 
 def orientation_figures(
     R: NDArray[np.float64], same_rad: float = SAME_ORIENTATION_RAD
-) -> tuple[int, float]:
+) -> tuple[int, float | None]:
     """``(orientations, smallest rotation between two of them, rad)`` of rotations ``R``
     (n, 3, 3): views within ``same_rad`` of an earlier kept one share its orientation; the
-    rotation is ``nan`` for a single orientation."""
+    rotation is None for a single orientation (``caltour.json`` holds it: JSON has no NaN)."""
     kept: list[Rotation] = []
     for r in Rotation.from_matrix(np.asarray(R, dtype=float)):
         if all((k.inv() * r).magnitude() >= same_rad for k in kept):
             kept.append(r)
     gaps = [(a.inv() * b).magnitude() for i, a in enumerate(kept) for b in kept[i + 1 :]]
-    return len(kept), float(min(gaps)) if gaps else float("nan")
+    return len(kept), float(min(gaps)) if gaps else None

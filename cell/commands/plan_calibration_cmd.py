@@ -102,7 +102,7 @@ def orientation_line(design: dict, views: int) -> str:
     shared = (
         "" if k == views else f" (the other {views - k} repeat one from another distance or offset)"
     )
-    between = "" if k < 2 else f", at least {np.degrees(gap):.1f} deg apart"
+    between = "" if gap is None else f", at least {np.degrees(gap):.1f} deg apart"
     return f"orientations  {k} distinct{between}{shared}"
 
 

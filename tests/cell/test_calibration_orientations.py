@@ -20,7 +20,10 @@ def test_views_from_one_direction_share_an_orientation() -> None:
     k, gap = orientation_figures(R)
     assert k == 3 and np.degrees(gap) == pytest.approx(30.0)
     assert orientation_figures(_R([0, 0, 0], [0, 0, 0]))[0] == 1
-    assert np.isnan(orientation_figures(_R([0, 0, 0]))[1])
+    assert orientation_figures(_R([0, 0, 0])) == (1, None)
+    assert orientation_line(
+        {"orientations": 1, "min_rotation_between_orientations_rad": None}, 3
+    ) == ("orientations  1 distinct (the other 2 repeat one from another distance or offset)")
 
 
 def test_the_summary_line() -> None:
