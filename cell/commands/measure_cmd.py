@@ -9,12 +9,17 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from cell.commands.argtypes import output_file
 from measure import MeasureOptions, StereoCalibration, measure_hole
 from measure.errors import ImageError, MeasurementError
 
 
 def read_image(path: str, which: str) -> np.ndarray:
     """Read an 8- or 16-bit image as single-channel (colour is converted to gray)."""
+    if Path(path).is_dir():
+        raise ImageError(
+            which, f"{path}: is a directory, not an image (--pairs DIR measures a folder)"
+        )
     if not Path(path).is_file():
         raise ImageError(which, f"{path}: no such file")
     img = cv2.imread(path, cv2.IMREAD_UNCHANGED)
@@ -45,7 +50,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("left", nargs="?", help="left camera image")
     p.add_argument("right", nargs="?", help="right camera image")
     p.add_argument("--pairs", metavar="DIR|LIST", help="measure every pair of a folder or list")
-    p.add_argument("-o", "--output", help="with --pairs: write the rows to FILE (.csv or .json)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        help="with --pairs: write the rows to FILE (.csv or .json)",
+    )
     p.add_argument("--stereo", required=True, help="stereo calibration file (stereo.json)")
     p.add_argument("--diameter", type=float, default=None, help="expected diameter (metres)")
     p.add_argument(

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from cell.commands.argtypes import output_file
 from robots.dh import DHTable, dh_table
 from robots.models import MODELS
 from robots.thermal import (
@@ -72,7 +73,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     ident.add_argument("observations", type=Path, metavar="OBS.csv")
     ident.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
-    ident.add_argument("-o", "--output", type=Path, required=True, metavar="thermal.json")
+    ident.add_argument("-o", "--output", type=output_file, required=True, metavar="thermal.json")
     ident.add_argument(
         "--sensor-map",
         metavar="S1,..,S6",
@@ -96,7 +97,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     pred.add_argument("model", type=Path, metavar="thermal.json")
     pred.add_argument("poses", type=Path, metavar="POSES.csv")
-    pred.add_argument("-o", "--output", type=Path, help="output CSV (default: standard output)")
+    pred.add_argument(
+        "-o", "--output", type=output_file, help="output CSV (default: standard output)"
+    )
     pred.add_argument(
         "--command",
         dest="joint_command",
@@ -113,7 +116,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "+15 K in two hours) and writes the observations CSV that 'thermal identify' reads.",
     )
     sim.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
-    sim.add_argument("-o", "--output", type=Path, required=True, metavar="OBS.csv")
+    sim.add_argument("-o", "--output", type=output_file, required=True, metavar="OBS.csv")
     sim.add_argument("--hours", type=float, default=2.0, help="warm-up duration (default 2)")
     sim.add_argument("--every-s", type=float, default=300.0, help="period (s, default 300)")
     sim.add_argument("--noise-um", type=float, default=5.0, help="noise per axis (um, default 5)")

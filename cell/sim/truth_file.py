@@ -186,6 +186,8 @@ def parse_truth_spec(text: str, source: str) -> TruthSpec:
 def read_truth_spec(path: str | Path) -> TruthSpec:
     """Read and validate the truth file at ``path``."""
     p = Path(path)
+    if p.is_dir():
+        raise TruthFileError(str(p), [("(file)", str(p), "is a directory, not a truth file")])
     if not p.is_file():
         raise TruthFileError(str(p), [("(file)", str(p), "no such file")])
     try:
