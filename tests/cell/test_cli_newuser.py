@@ -90,3 +90,32 @@ def test_folders_given_for_files_and_missing_run_folders_are_named(tmp_path: Pat
     assert f"left image: {d}: is a directory, not an image" in _one_line(capsys)
     assert main(["report", missing]) == 2
     assert _one_line(capsys).endswith(f"{missing}: no such run directory")
+
+
+def test_a_negative_seed_is_refused_by_the_planner_options(capsys) -> None:
+    import numpy as np
+
+    from planner import Options
+    from planner.errors import OptionsError
+
+    assert main(["plan", "--seed", "-1", "--quiet"]) == 2
+    assert "planner option seed=-1: must be an integer in [0, " in _one_line(capsys)
+    assert Options(seed=np.int64(3)).seed == 3
+    with pytest.raises(OptionsError):
+        Options(seed=2**40)
+
+
+def test_calibrate_stereo_names_an_unmatched_glob_and_a_millimetre_pitch(tmp_path, capsys):
+    import cv2
+    import numpy as np
+
+    img = tmp_path / "l.png"
+    cv2.imwrite(str(img), np.zeros((8, 8), np.uint8))
+    board = ["--cols", "8", "--rows", "6"]
+    nomatch = str(tmp_path / "none*.png")
+    assert main(["calibrate", "stereo", "--left", nomatch, "--right", str(img), *board,
+                 "--pitch", "0.012"]) == 2  # fmt: skip
+    assert _one_line(capsys).endswith(f"--left {nomatch}: no image matches")
+    assert main(["calibrate", "stereo", "--left", str(img), "--right", str(img), *board,
+                 "--pitch", "12"]) == 2  # fmt: skip
+    assert _one_line(capsys).endswith("--pitch 12: metres expected, this looks like millimetres")
