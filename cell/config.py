@@ -21,7 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError,
 from cell.config_checks import cell_problems
 from cell.config_mesh import MeshSpec
 from cell.config_target import CalibrationTargetBoard
-from cell.errors import ConfigError
+from cell.errors import NO_VALUE, ConfigError
 from cell.gdt.datums import Alignment, Datum, Tolerances, gdt_problems
 from cell.holes_csv import read_holes_csv
 from cell.uncertainty.materials import (
@@ -386,6 +386,8 @@ def _pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
         msg = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
             msg = "unknown key"
+        if err["type"] == "missing":  # pydantic's input is then the mapping around the key
+            msg, err["input"] = "a required key is missing", NO_VALUE
         problems.append((_field_path(err["loc"]), err.get("input"), msg))
     return problems
 

@@ -90,3 +90,15 @@ def output_file(text: str) -> Path:
     if not path.parent.is_dir():
         raise argparse.ArgumentTypeError(f"{text}: folder {path.parent} does not exist")
     return path
+
+
+def hole_diameter_m(text: str) -> float:
+    """A hole diameter (m): positive, and not so large that it must be millimetres."""
+    from cell.gdt.plausible import MAX_DIAMETER_M
+
+    value = positive_float(text)
+    if value > MAX_DIAMETER_M:
+        raise argparse.ArgumentTypeError(
+            f"{value:g} m: metres expected, this looks like millimetres ({value / 1e3:g} m?)"
+        )
+    return value

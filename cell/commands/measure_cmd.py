@@ -9,7 +9,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from cell.commands.argtypes import output_file
+from cell.commands.argtypes import hole_diameter_m, output_file
 from measure import MeasureOptions, StereoCalibration, measure_hole
 from measure.errors import ImageError, MeasurementError
 
@@ -57,7 +57,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="with --pairs: write the rows to FILE (.csv or .json)",
     )
     p.add_argument("--stereo", required=True, help="stereo calibration file (stereo.json)")
-    p.add_argument("--diameter", type=float, default=None, help="expected diameter (metres)")
+    p.add_argument(
+        "--diameter", type=hole_diameter_m, default=None, help="expected diameter (metres)"
+    )
     p.add_argument(
         "--method",
         choices=("default", "published"),

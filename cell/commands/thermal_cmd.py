@@ -268,18 +268,12 @@ def run_predict(args: argparse.Namespace) -> int:
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulated warm-up observations of the cell's reference targets."""
     from cell.config import load_cell
-    from cell.errors import ConfigError
+    from cell.errors import CellError
 
     if not (0 < args.hours < 1e3 and 0 < args.every_s < 1e6 and 0 <= args.noise_um < 1e6):
-        raise ConfigError(
-            "holecell thermal simulate",
-            [
-                (
-                    "--hours/--every-s/--noise-um",
-                    (args.hours, args.every_s, args.noise_um),
-                    "need a positive duration and period and a non-negative noise",
-                )
-            ],
+        raise CellError(
+            f"--hours {args.hours:g}, --every-s {args.every_s:g}, --noise-um {args.noise_um:g}: "
+            "need a positive duration and period and a non-negative noise"
         )
     cfg = load_cell(args.cell)
     geometry, _, table = _geometry(cfg, args.cell)

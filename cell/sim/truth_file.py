@@ -135,6 +135,8 @@ def _problems(exc: ValidationError, prefix: tuple[Any, ...] = ()) -> list[tuple[
         msg = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
             msg = "unknown key"
+        if err["type"] == "missing":  # pydantic's input is then the mapping around the key
+            msg, err["input"] = "a required key is missing", NO_VALUE
         out.append((_field_path((*prefix, *err["loc"])), _shown(err.get("input")), msg))
     return out
 

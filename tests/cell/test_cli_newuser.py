@@ -119,3 +119,26 @@ def test_calibrate_stereo_names_an_unmatched_glob_and_a_millimetre_pitch(tmp_pat
     assert main(["calibrate", "stereo", "--left", str(img), "--right", str(img), *board,
                  "--pitch", "12"]) == 2  # fmt: skip
     assert _one_line(capsys).endswith("--pitch 12: metres expected, this looks like millimetres")
+
+
+def test_a_missing_key_is_named_without_the_mapping_around_it(tmp_path: Path, capsys) -> None:
+    p = tmp_path / "cell.yaml"
+    p.write_text("x: 1\n")
+    assert main(["cell", "show", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert f"{p}: robot: a required key is missing\n" in err and "{'x': 1}" not in err
+    t = tmp_path / "truth.yaml"
+    t.write_text("tool: {tcp_error: {rpy: [0, 0, 0]}}\n")
+    assert main(["sim", "--truth", str(t)]) == 2
+    assert _one_line(capsys).endswith(f"{t}: tool.tcp_error.xyz: a required key is missing")
+
+
+def test_thermal_simulate_and_measure_name_the_bad_number(tmp_path: Path, capsys) -> None:
+    out = str(tmp_path / "o.csv")
+    args = ["thermal", "simulate", "--cell", "motorcycle_frame", "-o", out, "--hours", "-1"]
+    assert main(args) == 2
+    line = _one_line(capsys)
+    assert line.startswith("holecell thermal: error: --hours -1, --every-s ")
+    with pytest.raises(SystemExit):
+        main(["measure", "a.png", "b.png", "--stereo", "s.json", "--diameter", "12"])
+    assert "--diameter: 12 m: metres expected, this looks like millimetres" in _one_line(capsys)
