@@ -7,7 +7,7 @@ import argparse
 import numpy as np
 
 from cell.commands.argtypes import output_file
-from cell.commands.calibrate_stereo_cmd import add_board_arguments, spec_pitch_in_mm
+from cell.commands.calibrate_stereo_cmd import add_board_arguments
 
 DESCRIPTION = (
     "Estimates the hand-eye (the left camera's pose in tool0, T_tool0_camera), the target's "
@@ -104,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
         spec = TargetSpec(args.pattern, args.cols, args.rows, args.pitch)
     except ValueError as exc:
         raise CalibrationDataError("--cols/--rows/--pitch", str(exc)) from None
-    if spec_pitch_in_mm(spec.pitch_m):
+    if spec.pitch_m > 0.2:
         raise CalibrationDataError("--pitch", f"{spec.pitch_m:g} m looks like millimetres")
     cell = load_cell(args.cell) if args.cell else None
     arm = cell.build_robot() if cell is not None else None

@@ -89,25 +89,12 @@ def add_board_arguments(p: argparse.ArgumentParser, required: bool = True) -> No
     )
 
 
-#: the largest plausible square side / grid pitch of a calibration board (m)
-MAX_PITCH_M = 0.2
-
-
-def spec_pitch_in_mm(pitch: float | None) -> bool:
-    """Whether a board pitch (m) is too large to be metres (a pitch typed in mm)."""
-    return pitch is not None and pitch > MAX_PITCH_M
-
-
 def run(args: argparse.Namespace) -> int:
     """Handler: detect, calibrate, report, write."""
     lefts, rights = _expand(args.left), _expand(args.right)
     for flag, given, found in (("--left", args.left, lefts), ("--right", args.right, rights)):
         if not found:
             raise CalibrationTargetError(f"{flag} {' '.join(given)}: no image matches", [])
-    if spec_pitch_in_mm(args.pitch):
-        raise CalibrationTargetError(
-            f"--pitch {args.pitch:g}: metres expected, this looks like millimetres", []
-        )
     if len(lefts) != len(rights):
         raise CalibrationTargetError(
             f"need the same number of left and right images, got {len(lefts)} and {len(rights)}", []
