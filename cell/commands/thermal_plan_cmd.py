@@ -163,8 +163,6 @@ def read_views(path: Path, cell: CellConfig) -> list[tuple[str, np.ndarray]]:
 def run_plan_views(args: argparse.Namespace) -> int:
     """Design the reference views, write them, print the predicted residual per stop."""
     cell = load_cell(args.cell)
-    if not args.output.parent.is_dir():
-        raise CellError(f"-o {args.output}: the directory {args.output.parent} does not exist")
     extra = [_target(t, k) for k, t in enumerate(args.try_target)]
     if args.every_s > args.hours * 3600:
         raise CellError(
