@@ -36,6 +36,7 @@ from cell.config_shapes import SHAPE_KINDS, Box, Cylinder, ShapeSpec, Sphere
 from cell.errors import ConfigError
 from cell.gdt.datum_checks import gdt_problems
 from cell.holes_csv import read_holes_csv
+from cell.yaml_problem import yaml_problem
 
 __all__ = [
     "BUILTIN_CELLS",
@@ -101,7 +102,7 @@ def parse_cell(text: str, source: str = "<cell>", source_path: Path | None = Non
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        raise ConfigError(source, [("(yaml)", None, f"not valid YAML: {exc}")]) from exc
+        raise ConfigError(source, [yaml_problem(exc)]) from None
     if not isinstance(data, dict):
         raise ConfigError(source, [("(top level)", data, "a cell file is a mapping of keys")])
     try:

@@ -8,6 +8,8 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from cell.errors import NO_VALUE
+
 
 def field_path(loc: tuple[Any, ...]) -> str:
     """A pydantic error location as the file's field path: ``part.holes[3].normal``."""
@@ -27,5 +29,7 @@ def pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
         msg = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
             msg = "unknown key"
+        if err["type"] == "missing":  # pydantic's input is then the mapping around the key
+            msg, err["input"] = "a required key is missing", NO_VALUE
         problems.append((field_path(err["loc"]), err.get("input"), msg))
     return problems

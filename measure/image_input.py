@@ -24,6 +24,9 @@ def read_image(path: str | Path, which: str) -> np.ndarray:
     ``which`` names the image in the :class:`ImageError` raised for a missing or unreadable
     file (``"left"``, ``"right"``).
     """
+    if Path(path).is_dir():
+        hint = "(--pairs DIR measures a folder)"
+        raise ImageError(which, f"{path}: is a directory, not an image {hint}")
     if not Path(path).is_file():
         raise ImageError(which, f"{path}: no such file")
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)

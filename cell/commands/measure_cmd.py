@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 
+from cell.commands.argtypes import hole_diameter_m, output_file
 from measure import MeasureOptions, StereoCalibration, measure_hole
 from measure.errors import ImageError, MeasurementError
 from measure.image_input import read_image
@@ -34,9 +35,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("left", nargs="?", help="left camera image")
     p.add_argument("right", nargs="?", help="right camera image")
     p.add_argument("--pairs", metavar="DIR|LIST", help="measure every pair of a folder or list")
-    p.add_argument("-o", "--output", help="with --pairs: write the rows to FILE (.csv or .json)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        help="with --pairs: write the rows to FILE (.csv or .json)",
+    )
     p.add_argument("--stereo", required=True, help="stereo calibration file (stereo.json)")
-    p.add_argument("--diameter", type=float, default=None, help="expected diameter (metres)")
+    p.add_argument(
+        "--diameter", type=hole_diameter_m, default=None, help="expected diameter (metres)"
+    )
     p.add_argument(
         "--method",
         choices=("default", "published"),

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from cell.commands.argtypes import output_file
 from cell.commands.group_help import help_handler
 from robots.dh import DHTable
 from robots.dh_models import dh_table
@@ -74,7 +75,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     ident.add_argument("observations", type=Path, metavar="OBS.csv")
     ident.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
-    ident.add_argument("-o", "--output", type=Path, required=True, metavar="thermal.json")
+    ident.add_argument("-o", "--output", type=output_file, required=True, metavar="thermal.json")
     ident.add_argument(
         "--sensor-map",
         metavar="S1,..,S6",
@@ -98,7 +99,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     pred.add_argument("model", type=Path, metavar="thermal.json")
     pred.add_argument("poses", type=Path, metavar="POSES.csv")
-    pred.add_argument("-o", "--output", type=Path, help="output CSV (default: standard output)")
+    pred.add_argument(
+        "-o", "--output", type=output_file, help="output CSV (default: standard output)"
+    )
     pred.add_argument(
         "--command",
         dest="joint_command",
@@ -115,7 +118,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "+15 K in two hours) and writes the observations CSV that 'thermal identify' reads.",
     )
     sim.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
-    sim.add_argument("-o", "--output", type=Path, required=True, metavar="OBS.csv")
+    sim.add_argument("-o", "--output", type=output_file, required=True, metavar="OBS.csv")
     sim.add_argument("--hours", type=float, default=2.0, help="warm-up duration (default 2)")
     sim.add_argument("--every-s", type=float, default=300.0, help="period (s, default 300)")
     sim.add_argument("--noise-um", type=float, default=5.0, help="noise per axis (um, default 5)")
@@ -262,18 +265,12 @@ def run_predict(args: argparse.Namespace) -> int:
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulated warm-up observations of the cell's reference targets."""
     from cell.config import load_cell
-    from cell.errors import ConfigError
+    from cell.errors import CellError
 
     if not (0 < args.hours < 1e3 and 0 < args.every_s < 1e6 and 0 <= args.noise_um < 1e6):
-        raise ConfigError(
-            "holecell thermal simulate",
-            [
-                (
-                    "--hours/--every-s/--noise-um",
-                    (args.hours, args.every_s, args.noise_um),
-                    "need a positive duration and period and a non-negative noise",
-                )
-            ],
+        raise CellError(
+            f"--hours {args.hours:g}, --every-s {args.every_s:g}, --noise-um {args.noise_um:g}: "
+            "need a positive duration and period and a non-negative noise"
         )
     cfg = load_cell(args.cell)
     geometry, _, table = _geometry(cfg, args.cell)

@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from cell.gdt.datums import Datum, Problem, frame_problem
+from cell.gdt.plausible import size_problems
 
 if TYPE_CHECKING:
     from cell.config_schema import CellConfig
@@ -27,7 +28,9 @@ def gdt_problems(cfg: CellConfig) -> list[Problem]:
         seen.add(d.label)
         problems += _datum_problems(where, d, holes)
     for i, h in enumerate(cfg.part.holes):
-        problems += _hole_problems(f"part.holes[{i}]", h, datums)
+        problems += size_problems(f"part.holes[{i}]", h) + _hole_problems(
+            f"part.holes[{i}]", h, datums
+        )
     a = cfg.part.alignment
     if a is not None and a.datums is not None:
         problems += _frame_problems("part.alignment.datums", a.datums, datums)

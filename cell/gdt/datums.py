@@ -20,7 +20,8 @@ Per hole, under ``tolerances`` (a hole's ``position`` is its nominal centre alre
 and ``size: {upper_m, lower_m}`` (deviations from the nominal diameter, m, as the drawing
 writes them: H8 on 10 mm is ``{upper_m: 2.2e-5, lower_m: 0}``). The older single
 ``tolerance`` keeps working (see docs/gdt.md); a hole carries either it or ``tolerances``,
-never both.
+never both. Figures too large to be metres (millimetres typed unchanged) are refused by
+:mod:`cell.gdt.plausible`.
 
 ``part.alignment`` picks the run's alignment (the frame of the placement and of holes
 without a position tolerance): ``{datums: [A, B, C]}`` or

@@ -88,6 +88,10 @@ class Store:
     def open(cls, run_dir: str | Path) -> Store:
         """Reopen the store of ``run_dir``; refuses a missing, corrupt or foreign file."""
         path = Path(run_dir) / FILENAME
+        if not Path(run_dir).exists():
+            raise StoreError(Path(run_dir), "no such run directory")
+        if not Path(run_dir).is_dir():
+            raise StoreError(Path(run_dir), "a file, not a run directory")
         if not path.is_file():
             raise StoreError(path, "no results store here (not a run directory)")
         version = checked_version(path)
