@@ -24,11 +24,14 @@ _lock = threading.Lock()
 
 
 def _key(stereo: StereoCalibration, side: str) -> bytes:
-    K, d = (stereo.K_left, stereo.dist_left) if side == "left" else (stereo.K_right, stereo.dist_right)
+    K, d = (
+        (stereo.K_left, stereo.dist_left) if side == "left" else (stereo.K_right, stereo.dist_right)
+    )
     size = np.asarray(stereo.image_size, dtype=np.int64)
-    return b"|".join(
-        np.ascontiguousarray(a, dtype=np.float64).tobytes() for a in (K, d)
-    ) + size.tobytes()
+    return (
+        b"|".join(np.ascontiguousarray(a, dtype=np.float64).tobytes() for a in (K, d))
+        + size.tobytes()
+    )
 
 
 def _compute(stereo: StereoCalibration, side: str) -> tuple[np.ndarray, np.ndarray]:
