@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 #: reflectance of the black and white print and of what lies around the plate
@@ -66,12 +65,13 @@ def _sides(u: float, gx: float, gy: float, lo: float, hi: float) -> tuple[float,
 @njit(cache=True)
 def _pixel(kind, u, v, ux, uy, vx, vy, cols, rows, radius, ulo, uhi, vlo, vhi) -> float:
     """Reflectance of one pixel: plate coordinates ``(u, v)`` (pitches), their gradients."""
-    mu = 0.75 * math.sqrt(ux * ux + uy * uy)
-    mv = 0.75 * math.sqrt(vx * vx + vy * vy)
-    near = abs(u - ulo) < mu or abs(u - uhi) < mu or abs(v - vlo) < mv or abs(v - vhi) < mv
+    # within 0.75 px of an edge: (distance in u)^2 < 0.75^2 |grad u|^2
+    mu2 = 0.5625 * (ux * ux + uy * uy)
+    mv2 = 0.5625 * (vx * vx + vy * vy)
+    near = min((u - ulo) ** 2, (u - uhi) ** 2) < mu2 or min((v - vlo) ** 2, (v - vhi) ** 2) < mv2
     on = ulo < u < uhi and vlo < v < vhi
     if kind == CHESSBOARD:
-        near = near or abs(u - math.floor(u + 0.5)) < mu or abs(v - math.floor(v + 0.5)) < mv
+        near = near or (u - math.floor(u + 0.5)) ** 2 < mu2 or (v - math.floor(v + 0.5)) ** 2 < mv2
         if not near:
             if not on:
                 return SURROUND
@@ -118,34 +118,31 @@ def plate_image(nx, ny, box, H, kind, cols, rows, radius, bounds, light, out) ->
     h, w = out.shape
     gain, strength, cx, cy, rc2 = light[0], light[1], light[2], light[3], light[4]
     x0, y0, x1, y1 = box[0], box[1], box[2], box[3]
-    bh, bw = y1 - y0, x1 - x0
-    U = np.empty((bh, bw))
-    V = np.empty((bh, bw))
-    front = np.empty((bh, bw), dtype=np.bool_)
-    for r in range(bh):
-        for c in range(bw):
-            x, y = float(nx[y0 + r, x0 + c]), float(ny[y0 + r, x0 + c])
-            den = H[2, 0] * x + H[2, 1] * y + H[2, 2]
-            front[r, c] = den > 0.0
-            U[r, c] = (H[0, 0] * x + H[0, 1] * y + H[0, 2]) / den
-            V[r, c] = (H[1, 0] * x + H[1, 1] * y + H[1, 2]) / den
     ulo, uhi, vlo, vhi = bounds[0], bounds[1], bounds[2], bounds[3]
     for yy in range(h):
-        r = yy - y0
-        r0, r1 = max(r - 1, 0), min(r + 1, bh - 1)
         dy2 = (yy - cy) * (yy - cy)
+        r0, r1 = max(yy - 1, 0), min(yy + 1, h - 1)
         for xx in range(w):
-            c = xx - x0
             lit = gain * (1.0 - strength * ((xx - cx) * (xx - cx) + dy2) / rc2)
-            if r < 0 or r >= bh or c < 0 or c >= bw or not front[r, c]:
-                out[yy, xx] = SURROUND * lit
+            out[yy, xx] = SURROUND * lit
+            if yy < y0 or yy >= y1 or xx < x0 or xx >= x1:
                 continue
-            c0, c1 = max(c - 1, 0), min(c + 1, bw - 1)
-            ux = (U[r, c1] - U[r, c0]) / (c1 - c0)
-            uy = (U[r1, c] - U[r0, c]) / (r1 - r0)
-            vx = (V[r, c1] - V[r, c0]) / (c1 - c0)
-            vy = (V[r1, c] - V[r0, c]) / (r1 - r0)
-            refl = _pixel(
-                kind, U[r, c], V[r, c], ux, uy, vx, vy, cols, rows, radius, ulo, uhi, vlo, vhi
-            )
+            x, y = float(nx[yy, xx]), float(ny[yy, xx])
+            den = H[2, 0] * x + H[2, 1] * y + H[2, 2]
+            if den <= 0.0:
+                continue
+            u = (H[0, 0] * x + H[0, 1] * y + H[0, 2]) / den
+            v = (H[1, 0] * x + H[1, 1] * y + H[1, 2]) / den
+            # d(u, v)/d(pixel) = d(u, v)/d(ray) (the homography, exact) x d(ray)/d(pixel)
+            # (central differences of the rays)
+            c0, c1 = max(xx - 1, 0), min(xx + 1, w - 1)
+            rx_x = (nx[yy, c1] - nx[yy, c0]) / (c1 - c0)
+            ry_x = (ny[yy, c1] - ny[yy, c0]) / (c1 - c0)
+            rx_y = (nx[r1, xx] - nx[r0, xx]) / (r1 - r0)
+            ry_y = (ny[r1, xx] - ny[r0, xx]) / (r1 - r0)
+            au, bu = (H[0, 0] - u * H[2, 0]) / den, (H[0, 1] - u * H[2, 1]) / den
+            av, bv = (H[1, 0] - v * H[2, 0]) / den, (H[1, 1] - v * H[2, 1]) / den
+            ux, uy = au * rx_x + bu * ry_x, au * rx_y + bu * ry_y
+            vx, vy = av * rx_x + bv * ry_x, av * rx_y + bv * ry_y
+            refl = _pixel(kind, u, v, ux, uy, vx, vy, cols, rows, radius, ulo, uhi, vlo, vhi)
             out[yy, xx] = refl * lit

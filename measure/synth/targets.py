@@ -18,7 +18,7 @@ import numpy as np
 
 from measure.calibration import StereoCalibration
 from measure.synth.pixel_rays import pixel_rays
-from measure.synth.target_pattern import CHESSBOARD, CIRCLES, SURROUND, plate_image
+from measure.synth.target_pattern import CHESSBOARD, CIRCLES, plate_image
 from measure.target import TargetSpec
 
 #: relative illumination lost at the image corner
