@@ -152,8 +152,8 @@ def render_target_pair(
 
     Each pixel integrates the pattern over its area exactly, so ``supersample`` (the sample
     count per pixel side of the old point-sampling renderer) changes nothing; it is accepted
-    for old callers only. About 0.1 s per 5-megapixel view after the first view of a head
-    (which computes its rays, a few seconds).
+    for old callers only. About 0.2 s of CPU per view of a 5-megapixel head, after the first
+    view of a head (which computes its rays: a few seconds).
     """
     del supersample  # the area integral is exact: no samples to choose
     rng = np.random.default_rng(seed)
