@@ -173,7 +173,7 @@ def run(spec: TargetSpec, n_views: int, n_ss2: int) -> None:
         )
 
     print("\n1. where one capture's time goes (s)")
-    print(f"   head rays, once per head (both cameras)      {t_rays:8.3f}")
+    print(f"   head rays, once per head (both; 0: cached)   {t_rays:8.3f}")
     print(f"   new renderer, first view (after the rays)     {t_first:8.3f}")
     for stage, dt in stage_times(stereo, spec, Ts[0]):
         print(f"   new, left camera: {stage:28s} {dt:8.3f}")
