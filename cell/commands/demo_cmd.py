@@ -72,8 +72,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="do not calibrate the cell first: the run uses the nominal kinematics, base and "
         "head mount (the same truth: shows what the calibration removes)",
     )
-    p.add_argument("--calibration-views", type=int, default=30, metavar="N",
-                   help="views of the plate in the calibration (default 30)")  # fmt: skip
+    p.add_argument("--calibration-views", type=int, default=120, metavar="N",
+                   help="views of the plate in the calibration (default 120, as "
+                        "holecell plan-calibration)")  # fmt: skip
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")

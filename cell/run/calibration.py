@@ -174,19 +174,51 @@ class RunGeometry:
         T = self.T_cell_base @ fk_dh(self.dh, q)
         return T @ self.T_tool0_tcp if frame == "tcp" else T
 
-    def point_covariance_cell(self, q: Any, p_camera_m: Any) -> Array:
-        """Covariance (3, 3, m^2, cell frame axes) of a point fixed in the left camera's frame
-        at joints ``q`` that the calibration's uncertainty causes (zeros without one).
+    def point_factor_cell(self, q: Any, p_camera_m: Any) -> Array | None:
+        """``A`` (3, p), cell frame axes (m per unit normal): the error a point fixed in the
+        left camera's frame at joints ``q`` takes from the calibration's uncertainty is
+        ``A z`` with ``z ~ N(0, I_p)`` shared by every point of the run (one calibration for
+        the whole run); its covariance is ``A A^T``. None without a calibration.
 
-        Relative to the plate (``CalibratedKinematics.point_covariance(frame="target")``:
+        Relative to the plate (``CalibratedKinematics.point_jacobian(frame="target")``:
         hand-eye, D-H terms and the plate's pose with their correlations): the calibration
-        knows the head only against the plate, and ``base_link`` in the base frame's own
-        covariance is a gauge (its share moves every point together). Much of it is common to
-        all holes of a part (a rigid motion), which a datum alignment removes: in the datum
-        frame this component is conservative (docs/calibration.md)."""
+        knows the head only against the plate, and ``base_link`` alone is a gauge. Much of the
+        error is common to all holes of a part (a rigid motion): the shared ``z`` lets a
+        datum alignment remove it (:mod:`cell.gdt.montecarlo`)."""
         if self.run_calibration is None:
-            return np.zeros((3, 3))
+            return None
         kin = self.run_calibration.kinematics
-        C = kin.point_covariance(q, p_camera_m, frame="target")
+        J = kin.point_jacobian(q, p_camera_m, frame="target")
         R = self.T_cell_base[:3, :3] @ self.run_calibration.calibration.T_base_target.T[:3, :3]
-        return R @ C @ R.T
+        return R @ J @ kin.covariance_factor()
+
+    def point_covariance_cell(self, q: Any, p_camera_m: Any) -> Array:
+        """``A A^T`` of :meth:`point_factor_cell` (3, 3, m^2; zeros without a calibration)."""
+        A = self.point_factor_cell(q, p_camera_m)
+        return np.zeros((3, 3)) if A is None else A @ A.T
+
+
+def calibration_summary(run_dir: str | Path, now: datetime | None = None) -> dict[str, Any] | None:
+    """The report's ``calibration`` fields of the copy a run stored (None: the run used none;
+    a copy that cannot be read any more says so in ``error``)."""
+    path = stored_calibration_path(run_dir)
+    if path is None:
+        return None
+    try:
+        cal = load_calibration(path)
+    except CalibrationFileError as exc:
+        return {"file": str(path), "error": str(exc)}
+    return RunCalibration(cal, CalibratedKinematics(cal), str(path)).info(now)
+
+
+def describe(info: dict[str, Any] | None) -> str:
+    """One line for people: file, date, age, the hand-eye's sigma (mm, deg)."""
+    if info is None:
+        return "none: the cell file's kinematics, base and head mount taken as exact"
+    if "error" in info:
+        return f"{info['file']}: {info['error']}"
+    s_p = float(np.linalg.norm(info["sigma_hand_eye_xyz_m"]))
+    s_r = float(np.degrees(np.linalg.norm(info["sigma_hand_eye_rot_rad"])))
+    return (f"{info['file']}, made {info['created_utc']} ({info['age_days']:.1f} days before "
+            f"the report); hand-eye sigma {s_p * 1e3:.4f} mm, {s_r:.4f} deg; "
+            f"{info['views']} views, {info['dh_terms_free']} D-H terms estimated")  # fmt: skip

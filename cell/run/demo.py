@@ -84,7 +84,7 @@ class DemoOptions:
     realistic: bool = True
     geometry_errors: bool = True
     calibrate: bool = True
-    calibration_views: int = 30
+    calibration_views: int = 120
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
     truth: CellTruth | None = None
@@ -175,7 +175,8 @@ def _calibration(
     if not (opts.calibrate and opts.realistic):
         return None, None
     run_dir = files.store.path.parent
-    cal = calibrate_demo_cell(sim, files.cell, run_dir, opts.calibration_views, opts.seed)
+    cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
+                              opts.seed)  # fmt: skip
     arm = files.cell.build_robot()
     return cal, load_run_calibration(cal.path, files.cell, arm, sim.camera.stereo)
 

@@ -2,7 +2,8 @@
 
 :func:`calibrate_demo_cell` calibrates the simulated cell (:mod:`cell.run.sim_calibration`:
 the plate's corners projected through the simulated cell's true geometry at views of the
-plate, corner noise and the arm's repeatability added, one adjustment), writes
+plate chosen over the hole tour's joint range, corner noise and the arm's repeatability added,
+one adjustment), writes
 ``RUN_DIR/cellcal.json`` and measures the estimate against the simulation's truth (the
 hand-eye in the calibration's gauge: the structurally redundant D-H terms folded into it,
 :func:`cell.calibration.synthetic.truth_in_gauge`).
@@ -22,8 +23,9 @@ from cell.calibration.solve import pose_error
 from cell.calibration.synthetic import truth_in_gauge
 from cell.config import CellConfig
 from cell.run.calibration import RUN_FILENAME
-from cell.run.sim_calibration import simulated_calibration, synthetic_truth
+from cell.run.sim_calibration import design_views, simulated_calibration, synthetic_truth
 from cell.sim.session import SimCell
+from planner import Tour
 
 
 @dataclass(frozen=True)
@@ -51,19 +53,22 @@ class DemoCalibration:
 
 
 def calibrate_demo_cell(
-    sim: SimCell, cell: CellConfig, run_dir: Path, views: int, seed: int
+    sim: SimCell, cell: CellConfig, tour: Tour, run_dir: Path, views: int, seed: int
 ) -> DemoCalibration:
-    """Calibrate the simulated cell of ``sim`` and write ``run_dir/cellcal.json``."""
+    """Calibrate the simulated cell of ``sim`` for the hole tour ``tour`` (its joint range)
+    and write ``run_dir/cellcal.json``."""
     t0 = time.perf_counter()
     geometry = sim.world.true_geometry()
     stereo = sim.camera.stereo
+    q_views = design_views(cell, stereo, np.array([s.q for s in tour.stops]), views)
     res = simulated_calibration(cell, geometry, stereo, sim.world.truth.repeatability_rp_m,
-                                n_views=views, seed=seed)  # fmt: skip
+                                q_views, seed=seed)  # fmt: skip
     path = Path(run_dir) / RUN_FILENAME
     save_calibration(res.calibration, path)
     seconds = time.perf_counter() - t0
     gauge = truth_in_gauge(synthetic_truth(cell, geometry, stereo))
     dp, dr = pose_error(res.calibration.T_tool0_camera.T, gauge.T_tool0_camera)
     fixed = tuple(t.name for t in res.calibration.dh_terms if not t.free)
-    method = f"{views} simulated plate views (corners projected through the true cell)"
+    method = (f"{len(q_views)} views of the plate (planner's feasible views; corners projected "
+              "through the simulated cell, not rendered)")  # fmt: skip
     return DemoCalibration(path, res.calibration, seconds, dp, dr, fixed, method)

@@ -91,29 +91,33 @@ def inspect_hole(
     normal_part = T_part_cell[:3, :3] @ hole.normal
     result = _measured(meas, T_part_left, hole, nominal, t_meas, extra, base, ctx, normal_part)
     center_tcp = T_head_left[:3, :3] @ meas.center_m + T_head_left[:3, 3]
-    cal_cov, cal_note = _calibration_cov(arm, q_rad, meas.center_m, T_part_cell[:3, :3])
+    cal_A, cal_note = _calibration_factor(arm, q_rad, meas.center_m, T_part_cell[:3, :3])
+    cal_cov = None if cal_A is None else cal_A @ cal_A.T
     contributions = hole_contributions(
         ctx, stereo, meas, T_part_left[:3, :3], T_part_cell[:3, :3], model, arm.T_cell_base,
         arm.T_tool0_tcp, q_rad, temps_c, center_tcp, np.array(result.center_part_m),
         result.diameter_m, cal_cov, cal_note)  # fmt: skip
     delta = np.array(result.center_part_m) - nominal
     budget = combine(contributions, delta, normal_part, (ctx.part.note(),))
-    result = replace(result, extra={**result.extra, **gdt_extra(contributions, T_part_left)})
+    extra = {**result.extra, **gdt_extra(contributions, T_part_left)}
+    if cal_A is not None:  # the shared calibration error's factor, for the datum-frame draws
+        extra["cell_calibration_factor_part"] = cal_A.tolist()
+    result = replace(result, extra=extra)
     return _decided(result, budget, ctx.rule), meas
 
 
-def _calibration_cov(
+def _calibration_factor(
     arm: Arm | RunGeometry, q_rad: np.ndarray, center_left_m: np.ndarray, R_part_cell: np.ndarray
 ) -> tuple[np.ndarray | None, str]:
-    """The cell calibration's covariance of the centre (part frame, m^2) and its note; None
-    without a calibration."""
+    """The cell calibration's error factor of the centre (3, p, part frame: error ``A z``,
+    ``z ~ N(0, I)`` shared by the run) and its note; None without a calibration."""
     if not isinstance(arm, RunGeometry) or arm.run_calibration is None:
         return None, ""
-    C = R_part_cell @ arm.point_covariance_cell(q_rad, center_left_m) @ R_part_cell.T
+    A = R_part_cell @ arm.point_factor_cell(q_rad, center_left_m)
     rc = arm.run_calibration
     note = (f"{rc.source} ({rc.calibration.created_utc}): hand-eye, D-H terms and plate pose, "
             "first order with their correlations, relative to the plate")  # fmt: skip
-    return C, note
+    return A, note
 
 
 def _decided(result: HoleResult, budget, rule: str) -> HoleResult:

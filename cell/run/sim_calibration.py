@@ -3,12 +3,14 @@
 For tests of the run side and benchmarks: the target's corners are projected through the
 simulated cell's TRUE geometry (:class:`cell.sim.true_geometry.TrueGeometry`: D-H errors, the
 head on the flange, the base and the plate as they truly are) at arm poses that look at the
-plate (:func:`cell.calibration.synthetic.view_joints`), ``noise_px`` of corner noise and the
-arm's repeatability as a per-view flange scatter are added, and the adjustment
+plate (given, e.g. a planned calibration tour's stops, or :func:`design_views`: the
+calibration planner's feasible, collision-free views, pre-selected for rotations, image cover
+and the hole tour's joint range), ``noise_px`` of corner noise and the arm's repeatability as
+a per-view flange scatter are added, and the adjustment
 (:func:`cell.calibration.solve.solve_calibration`) estimates the calibration from them with
 the provenance of the run's cell. What this leaves out against a calibration from rendered
-images (``calibrate_cell``): the corner detector's errors, the plate's collision-free tour,
-and the true head's intrinsics being off its stereo file (the projection uses the file's).
+images (``calibrate_cell``): the corner detector's errors, the time to drive the tour, and
+the true head's intrinsics being off its stereo file (the projection uses the file's).
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 from cell.calibration.model import State
 from cell.calibration.observations import Cameras
 from cell.calibration.solve import CalibrationResult, SolveOptions, solve_calibration
-from cell.calibration.synthetic import SyntheticTruth, reference_joints, simulate, view_joints
+from cell.calibration.synthetic import SyntheticTruth, simulate
 from cell.config import CellConfig
 from cell.errors import CellError
 from cell.run.calibration import expected_provenance
@@ -50,21 +52,38 @@ def synthetic_truth(cell: CellConfig, geometry: TrueGeometry, stereo: StereoCali
                           cell.calibration_target.target_spec())  # fmt: skip
 
 
+def design_views(cell: CellConfig, stereo: StereoCalibration, stops_q: np.ndarray,
+                 n_views: int) -> np.ndarray:  # fmt: skip
+    """Joints (n, 6) of ``n_views`` views of the cell's plate: the calibration planner's
+    feasible views (both cameras see the whole board, IK within limits, no collision),
+    pre-selected geometrically over the joint range of the hole tour's stops ``stops_q``
+    (:func:`planner.calibration.preselect`; the I-optimal design of ``holecell
+    plan-calibration`` chooses better and takes a minute)."""
+    from cell.calibration_plan.head_model import stereo_model
+    from cell.calibration_plan.plan import joint_range
+    from cell.calibration_plan.target import board_of, cell_target
+    from planner.calibration import candidate_views, preselect
+
+    head = stereo_model(stereo)
+    cands = candidate_views(cell.build_arm(), board_of(cell_target(cell)), head,
+                            cell.tool.standoff_m, cell.home_q())  # fmt: skip
+    rows = preselect(cands, n_views, head.image_size, joint_range(stops_q))
+    return cands.q[rows]
+
+
 def simulated_calibration(
     cell: CellConfig,
     geometry: TrueGeometry,
     stereo: StereoCalibration,
     repeatability_rp_m: float,
-    n_views: int = 30,
+    q_views: np.ndarray,
     noise_px: float = 0.1,
     seed: int = 0,
 ) -> CalibrationResult:
-    """The calibration of the simulated cell from ``n_views`` projected views (see the module
-    docstring); raises the adjustment's refusals."""
+    """The calibration of the simulated cell from views at joints ``q_views`` (V, 6) (see
+    the module docstring); raises the adjustment's refusals."""
     truth = synthetic_truth(cell, geometry, stereo)
-    standoff = cell.tool.standoff_m
-    q = view_joints(truth, n_views, (0.85 * standoff, 1.15 * standoff),
-                    reference_joints(truth, standoff), seed=seed)  # fmt: skip
+    q = np.asarray(q_views, float)
     s = sigma_per_axis_m(repeatability_rp_m)
     obs = simulate(truth, q, noise_px, seed=seed + 1, flange_sigma_m=s,
                    flange_sigma_rad=s / SCATTER_LEVER_M, source="simulated views")  # fmt: skip
