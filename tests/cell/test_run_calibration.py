@@ -93,7 +93,7 @@ def test_an_old_calibration_is_refused_unless_the_limit_is_raised(
     path, _, cal = calibrated
     made = datetime.strptime(cal.created_utc, "%Y-%m-%dT%H:%M:%SZ").replace(tzinfo=UTC)
     later = made + timedelta(days=MAX_AGE_DAYS + 1)
-    with pytest.raises(CalibrationFileError, match="created_utc: made 8.0 days ago, older than"):
+    with pytest.raises(CalibrationFileError, match=r"created_utc: made 8\.0 days ago, older than"):
         _load(path, small_cell.cell, now=later)
     assert _load(path, small_cell.cell, now=later, max_age_days=30.0).source == str(path)
 
