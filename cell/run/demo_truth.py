@@ -91,6 +91,10 @@ class DatumError:
     alignment: str
     position_covered: list[bool] = field(default_factory=list)
     diameter_covered: list[bool] = field(default_factory=list)
+    #: after a least-squares rigid fit of all measured centres onto the true ones (no datum
+    #: feature's error carried over a lever): the measurement's own error, hole by hole
+    best_fit_rms_in_plane_m: float = float("nan")
+    best_fit_max_in_plane_m: float = float("nan")
 
     @property
     def coverage(self) -> float:
@@ -124,16 +128,34 @@ def datum_truth_error(world: SimWorld, results: list[HoleResult], run_dir: Path)
                           cov.of_kind("diameter"))  # fmt: skip
     T_meas = invert(_T(placed["T_fixture_part"]))  # fixture -> part (measured DRF)
     T_true = invert(_T(truth.placement["T_fixture_part"]))  # fixture -> part (true DRF)
-    normals = {h.id: np.asarray(h.normal, float) for h in cell.part.holes}
-    e = []
-    for r in results:
-        if r.center_part_m is None:
-            continue
-        m = T_meas[:3, :3] @ np.asarray(r.center_part_m) + T_meas[:3, 3]
-        t = T_true[:3, :3] @ centres[r.hole_id] + T_true[:3, 3]
-        n = normals[r.hole_id] / np.linalg.norm(normals[r.hole_id])
-        err = m - t
-        e.append(float(np.linalg.norm(err - (err @ n) * n)))
-    rms = float(np.sqrt(np.mean(np.square(e)))) if e else nan
-    return DatumError(rms, float(max(e, default=nan)), len(e), doc.get("alignment", ""),
-                      cov.of_kind("position"), cov.of_kind("diameter"))  # fmt: skip
+    normals = {h.id: np.asarray(h.normal, float) / np.linalg.norm(h.normal)
+               for h in cell.part.holes}  # fmt: skip
+    measured = [r for r in results if r.center_part_m is not None]
+    M = np.array([r.center_part_m for r in measured], float).reshape(-1, 3)
+    Tc = np.array([centres[r.hole_id] for r in measured], float).reshape(-1, 3)
+    N = np.array([normals[r.hole_id] for r in measured], float).reshape(-1, 3)
+    e = _in_plane(M @ T_meas[:3, :3].T + T_meas[:3, 3] - (Tc @ T_true[:3, :3].T + T_true[:3, 3]), N)
+    bf = _in_plane(_best_fit(M, Tc) - Tc, N) if len(M) >= 3 else np.array([])
+    return DatumError(_rms(e), _max(e), len(e), doc.get("alignment", ""),
+                      cov.of_kind("position"), cov.of_kind("diameter"), _rms(bf),
+                      _max(bf))  # fmt: skip
+
+
+def _max(v: np.ndarray) -> float:
+    return float(v.max()) if len(v) else float("nan")
+
+
+def _rms(v: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(v)))) if len(v) else float("nan")
+
+
+def _in_plane(err: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """``|err - (err . n) n|`` per row (m)."""
+    return np.linalg.norm(err - np.sum(err * normals, axis=1)[:, None] * normals, axis=1)
+
+
+def _best_fit(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a`` (N, 3) moved by the least-squares rigid motion onto ``b`` (Kabsch, SciPy)."""
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    R, _ = Rotation.align_vectors(b - cb, a - ca)
+    return R.apply(a - ca) + cb
