@@ -48,11 +48,11 @@ def options(seed: int, variant: str) -> DemoOptions:
     if variant == "exact-head":
         return replace(opts, truth=replace(truth, calibration_sigma_scale=0.0))
     if variant == "no-geometry":
-        zero = CellTruth.zero(seed)
-        return replace(opts, truth=replace(truth, dh_errors=zero.dh_errors,
-                                           base_error=zero.base_error, tcp_error=zero.tcp_error,
-                                           part_placement_error=zero.part_placement_error,
-                                           target_placement_error=zero.target_placement_error))  # fmt: skip
+        z = CellTruth.zero(seed)
+        flat = replace(truth, dh_errors=z.dh_errors, base_error=z.base_error,
+                       tcp_error=z.tcp_error, part_placement_error=z.part_placement_error,
+                       target_placement_error=z.target_placement_error)  # fmt: skip
+        return replace(opts, truth=flat)
     return opts
 
 
