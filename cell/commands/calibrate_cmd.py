@@ -2,8 +2,10 @@
 
 ``calibrate stereo`` (:mod:`cell.commands.calibrate_stereo_cmd`) calibrates the stereo head;
 ``calibrate hand-eye`` (:mod:`cell.commands.calibrate_handeye_cmd`) the head on the flange,
-the target in the base, the arm's D-H errors and the stereo extrinsics from recorded data.
-The older form ``holecell calibrate --left ... --right ...`` is the stereo calibration.
+the target in the base, the arm's D-H errors and the stereo extrinsics from recorded data;
+``calibrate cell`` (:mod:`cell.commands.calibrate_cell_cmd`) the same by running the calibration
+tour in the cell. The older form ``holecell calibrate --left ... --right ...`` is the stereo
+calibration.
 A new calibration is one more module in :data:`CALIBRATE_MODULES` with a ``register(sub)``.
 """
 
@@ -16,7 +18,11 @@ from cell.commands import calibrate_stereo_cmd
 from cell.errors import CellError
 
 #: the ``calibrate`` subcommands' modules under ``cell.commands``, in ``--help`` order
-CALIBRATE_MODULES: tuple[str, ...] = ("calibrate_stereo_cmd", "calibrate_handeye_cmd")
+CALIBRATE_MODULES: tuple[str, ...] = (
+    "calibrate_stereo_cmd",
+    "calibrate_handeye_cmd",
+    "calibrate_cell_cmd",
+)
 
 
 class CalibrateUsageError(CellError):
@@ -27,12 +33,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``calibrate`` subcommand and its own subcommands."""
     p = sub.add_parser(
         "calibrate",
-        help="calibrations: stereo head (stereo), hand-eye and kinematics (hand-eye)",
+        help="calibrations: stereo head (stereo), hand-eye and kinematics (hand-eye, cell)",
         description=(
             "Calibrations from images of a plate target. 'calibrate stereo' calibrates the "
             "stereo head; 'calibrate hand-eye' the head on the flange, the target in the base, "
             "the arm's D-H errors and the stereo extrinsics from images and robot poses "
-            "recorded elsewhere. Without a subcommand, --left/--right run the stereo "
+            "recorded elsewhere; 'calibrate cell' the same by running the calibration tour on "
+            "the controller and the head. Without a subcommand, --left/--right run the stereo "
             "calibration (the older form): " + calibrate_stereo_cmd.DESCRIPTION
         ),
     )
@@ -52,7 +59,7 @@ def _older_form(args: argparse.Namespace) -> int:
     ]
     if missing:
         raise CalibrateUsageError(
-            "give a subcommand (stereo, hand-eye) or the stereo calibration's options; missing: "
-            + ", ".join(missing)
+            "give a subcommand (stereo, hand-eye, cell) or the stereo calibration's options; "
+            "missing: " + ", ".join(missing)
         )
     return calibrate_stereo_cmd.run(args)

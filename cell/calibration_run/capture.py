@@ -1,0 +1,152 @@
+"""Running a calibration tour: move to each view, settle, capture a stereo pair, record the
+joints, detect the target in both images.
+
+The arm moves with the run's own machinery (:class:`cell.run.motion.Motion`: load and reload
+the trajectory, wait for "in position", reconnect within a budget, stop safely on a fault),
+so a calibration tour survives a dead link exactly as a hole tour does. The joints recorded
+for a view are the controller's report after the settle time, the ones the images were taken
+at. Detection is :func:`measure.target.find_target` on the left and the right image.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cell.calibration_run.orient import orient_chessboard
+from cell.link.client import ControllerClient
+from cell.run.camera import CameraBackend
+from cell.run.motion import Motion
+from measure.target import TargetSpec, find_target
+from planner import Tour
+
+log = logging.getLogger(__name__)
+
+Array = NDArray[np.float64]
+
+#: ``progress(event, data)``: "view" after each view (``k``, ``n``, ``id``, ``left``, ``right``:
+#: whether the target was found), "solve" before the adjustment, "done" at the end
+Progress = Callable[[str, dict], None]
+
+
+@dataclass(frozen=True)
+class CaptureSettings:
+    """Motion and detection settings: wait after "in position" (s), longest move (s), how long
+    a dead link is retried (s), widest accepted edge of a target image (px, 10-90 % rise)."""
+
+    settle_s: float = 0.2
+    move_timeout_s: float = 120.0
+    reconnect_budget_s: float = 15.0
+    max_edge_width_px: float = 4.0
+
+
+@dataclass(frozen=True, eq=False)
+class CapturedView:
+    """One view of the tour: its id, the joints and controller time at the capture, the
+    target's features in each image (px, ``None`` where not found) and why not."""
+
+    id: str
+    q_rad: Array
+    time_s: float
+    corners_left_px: Array | None
+    corners_right_px: Array | None
+    reason_left: str = ""
+    reason_right: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class TourCaptures:
+    """Every view of one tour, the controller clock at the start and the end (s: the robot
+    time) and the wall time of each step (s)."""
+
+    views: tuple[CapturedView, ...]
+    start_time_s: float
+    end_time_s: float
+    wall_s: dict[str, float]
+
+    @property
+    def robot_time_s(self) -> float:
+        """Controller time from the first move to home again (s)."""
+        return self.end_time_s - self.start_time_s
+
+
+class EventLog:
+    """What the motion steps report (a dead link, a reload): kept in memory and logged."""
+
+    def __init__(self) -> None:
+        self.events: list[tuple[str, str]] = []
+
+    def event(self, kind: str, message: str) -> None:
+        """Record one event."""
+        self.events.append((kind, message))
+        log.info("%s: %s", kind, message)
+
+
+class TourCapture(Motion):
+    """Runs a calibration tour on ``client`` and captures with ``camera``."""
+
+    def __init__(
+        self,
+        tour: Tour,
+        client: ControllerClient,
+        camera: CameraBackend,
+        target: TargetSpec,
+        settings: CaptureSettings | None = None,
+        progress: Progress | None = None,
+    ) -> None:
+        self.tour, self.client, self.camera, self.target = tour, client, camera, target
+        self.options = settings or CaptureSettings()
+        self.store = EventLog()
+        self.progress = progress or (lambda event, data: None)
+        self._loaded: Tour | None = None
+        self._need_load = False
+
+    def run(self) -> TourCaptures:
+        """Visit every view, capture and detect; go home. A fault stops the arm and raises."""
+        try:
+            return self._run()
+        except BaseException:
+            self._safe_stop()
+            raise
+
+    def _detect(self, image: np.ndarray) -> tuple[Array | None, str]:
+        """The target's features in the board's order (:mod:`.orient`), or why not found."""
+        det = find_target(image, self.target, self.options.max_edge_width_px)
+        if det.points is None:
+            return None, det.reason
+        return orient_chessboard(image, det.points, self.target), ""
+
+    def _run(self) -> TourCaptures:
+        wall = {"move_s": 0.0, "capture_s": 0.0, "detect_s": 0.0}
+        self._load(self.tour)
+        t_start = self._call("status", self.client.status).time_s
+        views = []
+        n = len(self.tour.stops)
+        for k, stop in enumerate(self.tour.stops):
+            t = time.perf_counter()
+            self._move(k, f"calibration view {stop.hole_id}")
+            st = self._settled_status()
+            wall["move_s"] += time.perf_counter() - t
+            t = time.perf_counter()
+            pair = self.camera.capture()
+            wall["capture_s"] += time.perf_counter() - t
+            t = time.perf_counter()
+            left, why_left = self._detect(pair.left)
+            right, why_right = self._detect(pair.right)
+            wall["detect_s"] += time.perf_counter() - t
+            view = CapturedView(stop.hole_id, np.asarray(st.q_rad, float).copy(),
+                                float(st.time_s), left, right, why_left, why_right)  # fmt: skip
+            views.append(view)
+            self.progress("view", {"k": k, "n": n, "id": stop.hole_id,
+                                   "left": left is not None,
+                                   "right": right is not None})  # fmt: skip
+        t = time.perf_counter()
+        self._move(n, "home after the calibration tour")
+        t_end = self._call("status", self.client.status).time_s
+        wall["move_s"] += time.perf_counter() - t
+        return TourCaptures(tuple(views), float(t_start), float(t_end), wall)

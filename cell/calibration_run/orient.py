@@ -1,0 +1,60 @@
+"""Chessboard corners in the board's own order, whatever order OpenCV's detector returned.
+
+OpenCV's chessboard detectors may start a board of ``cols`` x ``rows`` inner corners at either
+end: the same board seen in the left and the right image can come back in orders 180 deg
+apart (one view of a calibration tour did, on the simulated head), which puts every corner of
+that image on the wrong object point. The board frame (:mod:`measure.target`,
+docs/conventions.md) fixes the order:
+
+- handedness: x along a row, y down the rows, z into the plate, and the camera looks at the
+  printed face along +z, so the image of (x, y) keeps the image axes' handedness: the cross
+  product of the first row's direction and the first column's is positive in pixels (u right,
+  v down); a mirrored order has its rows reversed;
+- colour: the square spanned by the first two corners of the first two rows is black (the
+  square at x, y in (0, pitch) of :func:`measure.synth.targets` and of a board printed with
+  the origin on a black square); its neighbour along the row is white. Otherwise the order is
+  turned by 180 deg.
+
+A board of another convention (a white first square) then comes back consistently turned by
+180 deg, which a calibration absorbs in the board's pose (a measured ``corners_file`` must
+then be written in that order).
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from measure.target import TargetSpec, to_gray8
+
+Array = NDArray[np.float64]
+
+
+def _cell_mean(img: Array, grid: Array, i: int, j: int) -> float:
+    """Mean grey around the centre of the square between rows i, i+1 and columns j, j+1,
+    over a patch a quarter of the square's size."""
+    quad = grid[i : i + 2, j : j + 2].reshape(-1, 2)
+    c = quad.mean(axis=0)
+    half = max(1, int(0.125 * np.linalg.norm(grid[i, j] - grid[i + 1, j + 1])))
+    x0, y0 = round(float(c[0])), round(float(c[1]))
+    h, w = img.shape[:2]
+    patch = img[
+        max(0, y0 - half) : min(h, y0 + half + 1), max(0, x0 - half) : min(w, x0 + half + 1)
+    ]
+    return float(patch.mean()) if patch.size else float("nan")
+
+
+def orient_chessboard(gray: NDArray, points_px: Array, spec: TargetSpec) -> Array:
+    """``points_px`` (N, 2) reordered to the board's order (module docstring)."""
+    if spec.kind != "chessboard":
+        return points_px
+    grid = np.asarray(points_px, float).reshape(spec.rows, spec.cols, 2)
+    along, down = grid[0, 1] - grid[0, 0], grid[1, 0] - grid[0, 0]
+    if along[0] * down[1] - along[1] * down[0] < 0:
+        grid = grid[::-1]
+    img = cv2.GaussianBlur(to_gray8(gray), (3, 3), 0).astype(float)
+    first, beside = _cell_mean(img, grid, 0, 0), _cell_mean(img, grid, 0, 1)
+    if first > beside:
+        grid = grid[::-1, ::-1]
+    return grid.reshape(-1, 2).copy()
