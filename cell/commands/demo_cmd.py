@@ -75,6 +75,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--calibration-views", type=int, default=120, metavar="N",
                    help="views of the plate in the calibration (default 120, as "
                         "holecell plan-calibration)")  # fmt: skip
+    p.add_argument(
+        "--calibration-method",
+        choices=("images", "projected"),
+        default="images",
+        help="images (default): drive the calibration tour on the simulated cell, render and "
+        "detect the plate in both cameras, as holecell calibrate cell does; projected: the "
+        "plate's corners projected at the planner's views (seconds, no detector)",
+    )
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
@@ -219,6 +227,7 @@ def run_demo_cmd(args: argparse.Namespace) -> int:
             truth=truth,
             calibrate=not args.no_calibration,
             calibration_views=args.calibration_views,
+            calibration_method=args.calibration_method,
         ),
         _plan_bars(args.quiet),
         _progress(bars),

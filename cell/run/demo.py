@@ -25,7 +25,12 @@ from cell.config import CellConfig, load_builtin_cell
 from cell.link.client import ControllerClient
 from cell.review.report import write_report
 from cell.run.calibration import RunCalibration, load_run_calibration
-from cell.run.demo_calibrate import DemoCalibration, calibrate_demo_cell
+from cell.run.demo_calibrate import (
+    DemoCalibration,
+    calibrate_demo_cell,
+    calibrate_demo_cell_images,
+    plan_demo_caltour,
+)
 from cell.run.demo_truth import DatumError, TruthError, datum_truth_error, truth_error
 from cell.run.reference import plan_reference_tour
 from cell.run.runner import Progress, Runner, RunOptions, RunResult
@@ -37,6 +42,7 @@ from cell.sim.world import WorldOptions
 from cell.uncertainty.decision import DEFAULT_RULE
 from cell.uncertainty.repeatability import repeatability_rp_m
 from planner import Options, Tour, TourPlanner
+from planner.calibration import CalibrationTour, caltour_from_dict
 from planner.tour import tour_from_dict
 
 
@@ -66,6 +72,11 @@ class DemoOptions:
         calibrate: run the cell calibration on the simulated cell first and measure the part
             with it (False: ``--no-calibration``, the nominal kinematics).
         calibration_views: views of the plate of that calibration.
+        calibration_method: ``"images"``: the calibration tour driven on the simulated cell,
+            the plate rendered and detected (``calibrate cell``'s procedure);
+            ``"projected"``: the plate's corners projected at the planner's views (seconds;
+            :mod:`cell.run.demo_calibrate`).
+        calibration_speed: simulation speed while the calibration tour is driven.
         truth: every hidden error of the simulated cell (a truth file, ``--truth``); None:
             the drawn truth above (or, without ``geometry_errors``, no geometric error).
         decision_rule: the run's decision rule.
@@ -85,6 +96,8 @@ class DemoOptions:
     geometry_errors: bool = True
     calibrate: bool = True
     calibration_views: int = 120
+    calibration_method: str = "images"
+    calibration_speed: float = 20.0
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
     truth: CellTruth | None = None
@@ -115,18 +128,24 @@ def _plan_reference(seed: int) -> dict[str, Any]:
 
 
 def plan_demo(
-    cell: CellConfig, seed: int, plan_progress: Callable[[str, int, int], None] | None = None
-) -> tuple[Tour, Tour]:
-    """The hole tour and the reference tour of ``cell``; the reference tour is planned in a
-    second process while this one plans the holes. The second process is started by a fork
-    server, not forked from this one: a process that has run a simulator or a planner holds
-    threads (and their locks) that a forked child would inherit locked."""
+    cell: CellConfig,
+    seed: int,
+    plan_progress: Callable[[str, int, int], None] | None = None,
+    caltour_views: int = 0,
+) -> tuple[Tour, Tour, CalibrationTour | None]:
+    """The hole tour, the reference tour and (``caltour_views`` > 0) the calibration tour of
+    ``cell``; the other two are planned in worker processes while this one plans the holes.
+    The workers are started by a fork server, not forked from this one: a process that has
+    run a simulator or a planner holds threads (and their locks) that a forked child would
+    inherit locked."""
     ctx = multiprocessing.get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
+    with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
         ref_job = pool.submit(_plan_reference, seed)
+        cal_job = pool.submit(plan_demo_caltour, caltour_views, seed) if caltour_views else None
         tour = TourPlanner(Options(seed=seed), plan_progress).plan(cell)
         reference = tour_from_dict(ref_job.result(), "reference tour")
-    return tour, reference
+        caltour = None if cal_job is None else caltour_from_dict(cal_job.result(), "caltour")
+    return tour, reference, caltour
 
 
 def run_demo(
@@ -142,7 +161,9 @@ def run_demo(
     opts = options or DemoOptions()
     t0 = time.perf_counter()
     cell = load_builtin_cell()
-    tour, reference = plan_demo(cell, opts.seed, plan_progress)
+    images = opts.calibrate and opts.realistic and opts.calibration_method == "images"
+    tour, reference, caltour = plan_demo(cell, opts.seed, plan_progress,
+                                         opts.calibration_views if images else 0)  # fmt: skip
     t_plan = time.perf_counter() - t0
     # real time until the first reference round starts (its readings are the cold state)
     world = demo_world(cell, opts)
@@ -150,7 +171,7 @@ def run_demo(
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
         try:
-            cal, run_cal = _calibration(sim, files, opts)
+            cal, run_cal = _calibration(sim, files, opts, caltour)
             result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder,
                               run_cal)  # fmt: skip
             truth = truth_error(sim.world, files.store.results())
@@ -168,15 +189,19 @@ def run_demo(
 
 
 def _calibration(
-    sim: SimCell, files: RunFiles, opts: DemoOptions
+    sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None
 ) -> tuple[DemoCalibration | None, RunCalibration | None]:
     """Calibrate the simulated cell (``opts.calibrate`` and a realistic cell), write the
     calibration into the run directory and load it back as the run does (checked)."""
     if not (opts.calibrate and opts.realistic):
         return None, None
     run_dir = files.store.path.parent
-    cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
-                              opts.seed)  # fmt: skip
+    if caltour is not None:
+        cal = calibrate_demo_cell_images(sim, files.cell, caltour, run_dir,
+                                         opts.calibration_speed)  # fmt: skip
+    else:
+        cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
+                                  opts.seed)  # fmt: skip
     arm = files.cell.build_robot()
     return cal, load_run_calibration(cal.path, files.cell, arm, sim.camera.stereo)
 

@@ -1,18 +1,25 @@
 """The demo's first step: calibrate the simulated cell, and how good that calibration is.
 
-:func:`calibrate_demo_cell` calibrates the simulated cell (:mod:`cell.run.sim_calibration`:
-the plate's corners projected through the simulated cell's true geometry at views of the
-plate chosen over the hole tour's joint range, corner noise and the arm's repeatability added,
-one adjustment), writes
-``RUN_DIR/cellcal.json`` and measures the estimate against the simulation's truth (the
-hand-eye in the calibration's gauge: the structurally redundant D-H terms folded into it,
-:func:`cell.calibration.synthetic.truth_in_gauge`).
+Two ways (``DemoOptions.calibration_method``):
+
+- ``"images"``: :func:`calibrate_demo_cell_images` runs the calibration tour (planned as
+  ``holecell calibrate cell`` plans it, :func:`plan_demo_caltour`) on the simulated controller
+  and head with :func:`cell.calibration_run.run.run_calibration_tour`: the plate rendered in
+  both cameras at every view, detected, one adjustment. The whole procedure of a real cell.
+- ``"projected"``: :func:`calibrate_demo_cell` (:mod:`cell.run.sim_calibration`): the plate's
+  corners projected through the simulated cell's true geometry at the planner's feasible views
+  chosen over the hole tour's joint range, corner noise and the arm's repeatability added, one
+  adjustment. Seconds instead of minutes; no detector, no tour driven.
+
+Either writes ``RUN_DIR/cellcal.json`` and measures the estimate against the simulation's
+truth (the hand-eye in the calibration's gauge: the structurally redundant D-H terms folded
+into it, :func:`cell.calibration.synthetic.truth_in_gauge`).
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +33,12 @@ from cell.run.calibration import RUN_FILENAME
 from cell.run.sim_calibration import design_views, simulated_calibration, synthetic_truth
 from cell.sim.session import SimCell
 from planner import Tour
+from planner.calibration import CalibrationTour
+
+#: the demo's calibration tour is chosen by the geometric pre-selection (rotations, image
+#: cover, the hole tour's joint range), without the predicted sigma: as accurate here as the
+#: I-optimal design (docs/calibration.md, "The demo") and 45 s less planning
+CALTOUR_CRITERION = "geometric"
 
 
 @dataclass(frozen=True)
@@ -72,3 +85,46 @@ def calibrate_demo_cell(
     method = (f"{len(q_views)} views of the plate (planner's feasible views; corners projected "
               "through the simulated cell, not rendered)")  # fmt: skip
     return DemoCalibration(path, res.calibration, seconds, dp, dr, fixed, method)
+
+
+def plan_demo_caltour(views: int, seed: int) -> dict:
+    """The built-in cell's calibration tour as ``holecell calibrate cell`` plans it (JSON-ready:
+    planned in a worker process)."""
+    from cell.calibration_run.plan import calibrate_plan_options, plan_cell_calibration
+    from cell.config import load_builtin_cell
+    from cell.run.camera import cell_stereo
+
+    cell = load_builtin_cell()
+    opts = replace(calibrate_plan_options(views, seed), criterion=CALTOUR_CRITERION,
+                   predict=False)  # fmt: skip
+    return plan_cell_calibration(cell, cell_stereo(cell), opts).to_dict()
+
+
+def calibrate_demo_cell_images(
+    sim: SimCell, cell: CellConfig, caltour: CalibrationTour, run_dir: Path, speed: float
+) -> DemoCalibration:
+    """Run ``caltour`` on the simulated cell at ``speed`` (x real time), detect, solve
+    (:func:`cell.calibration_run.run.run_calibration_tour`); write ``run_dir/cellcal.json``."""
+    from cell.calibration_run.capture import CaptureSettings
+    from cell.calibration_run.run import CalibrateCellOptions, run_calibration_tour
+    from cell.link.client import ControllerClient
+
+    t0 = time.perf_counter()
+    sim.world.clock.set_speed(speed)
+    try:
+        opts = CalibrateCellOptions(capture=CaptureSettings(settle_s=0.2 / speed))
+        with ControllerClient(sim.url) as client:
+            run = run_calibration_tour(cell, caltour, client, sim.camera, opts)
+    finally:
+        sim.world.clock.set_speed(1.0)
+    cal = run.result.calibration
+    path = Path(run_dir) / RUN_FILENAME
+    save_calibration(cal, path)
+    seconds = time.perf_counter() - t0
+    gauge = truth_in_gauge(synthetic_truth(cell, sim.world.true_geometry(), sim.camera.stereo))
+    dp, dr = pose_error(cal.T_tool0_camera.T, gauge.T_tool0_camera)
+    fixed = tuple(t.name for t in cal.dh_terms if not t.free)
+    method = (f"calibration tour of {len(caltour.tour.stops)} views driven on the simulated "
+              f"controller ({run.captures.robot_time_s:.0f} s robot time), plate rendered and "
+              f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s")  # fmt: skip
+    return DemoCalibration(path, cal, seconds, dp, dr, fixed, method)
