@@ -82,7 +82,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="projected (default): the plate's corners projected through the simulated cell "
         "at the calibration planner's views (seconds, no detector); images: drive the "
         "calibration tour on the simulated cell, render and detect the plate in both cameras, "
-        "as holecell calibrate cell does (about 6 s per view while the plate renders slowly)",
+        "as holecell calibrate cell does (about 12 s per view here while the plate renders slowly)",
     )
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")

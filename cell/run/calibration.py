@@ -127,6 +127,22 @@ def stored_calibration_path(run_dir: str | Path) -> Path | None:
     return p if p.exists() else None
 
 
+def calibrated_stereo(
+    stereo: StereoCalibration, run_cal: RunCalibration | None
+) -> StereoCalibration:
+    """The head a run triangulates with: ``stereo`` (the file's intrinsics and uncertainty)
+    with the calibration's stereo extrinsics ``T_left_right`` when it estimated them (the
+    plate's known geometry fixes them in the cell, with the arm as it is); ``stereo`` itself
+    otherwise."""
+    if run_cal is None or run_cal.calibration.T_left_right is None:
+        return stereo
+    T_right_left = invert(run_cal.calibration.T_left_right.T)
+    return StereoCalibration(stereo.image_size, stereo.K_left, stereo.dist_left, stereo.K_right,
+                             stereo.dist_right, T_right_left[:3, :3].copy(),
+                             T_right_left[:3, 3].copy(), source=stereo.source,
+                             uncertainty=stereo.uncertainty)  # fmt: skip
+
+
 class RunGeometry:
     """The kinematics a run measures and commands with (see the module docstring).
 

@@ -75,7 +75,7 @@ def calibrate_demo_cell(
     stereo = sim.camera.stereo
     q_views = design_views(cell, stereo, np.array([s.q for s in tour.stops]), views)
     res = simulated_calibration(cell, geometry, stereo, sim.world.truth.repeatability_rp_m,
-                                q_views, seed=seed)  # fmt: skip
+                                q_views, seed=seed, true_stereo=sim.camera.true_stereo)  # fmt: skip
     path = Path(run_dir) / RUN_FILENAME
     save_calibration(res.calibration, path)
     seconds = time.perf_counter() - t0

@@ -24,7 +24,7 @@ from cell.errors import CellError
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError
 from cell.review.store import Store
-from cell.run.calibration import RunCalibration, RunGeometry
+from cell.run.calibration import RunCalibration, RunGeometry, calibrated_stereo
 from cell.run.camera import CameraBackend
 from cell.run.corrected_tour import correct_tour
 from cell.run.inspect import T_cell_tcp, inspect_hole
@@ -131,7 +131,9 @@ class Runner(Motion):
         self.recorder = recorder
         self.arm = cell.build_arm()
         target = cell.calibration_target
-        self.geometry = RunGeometry(self.arm, camera.stereo, calibration,
+        # the head as triangulated: the stereo file, with the calibration's extrinsics if any
+        self.stereo = calibrated_stereo(camera.stereo, calibration)
+        self.geometry = RunGeometry(self.arm, self.stereo, calibration,
                                     None if target is None else target.T_cell_target(),
                                     base_from)  # fmt: skip
         # the commanded poses: the planned stops corrected for the calibration (unchanged
@@ -142,7 +144,7 @@ class Runner(Motion):
                                                   "reference tour")  # fmt: skip
         self.holes = {h.id: h for h in cell.holes_in_cell()}
         self.thermal = ThermalUpdate(cell, self.geometry)
-        self._T_head_left = invert(head_frame(camera.stereo))
+        self._T_head_left = invert(head_frame(self.stereo))
         self.model_id: int | None = None
         self.budget: BudgetContext | None = None  # set once the reference phase is over
         self._round0 = 0
@@ -263,7 +265,7 @@ class Runner(Motion):
             self.store.event("part", part.note())
         else:
             part = PartThermalState.from_dict(stored)
-        return budget_context(self.cell, self.camera.stereo, part, o.decision_rule)
+        return budget_context(self.cell, self.stereo, part, o.decision_rule)
 
     # --- reference targets -----------------------------------------------------------------
     def _home_for_reference(self) -> None:
@@ -297,7 +299,7 @@ class Runner(Motion):
                 st = self._settled_status()
                 pair = self.camera.capture()
                 try:
-                    meas = measure_hole(pair.left, pair.right, self.camera.stereo)
+                    meas = measure_hole(pair.left, pair.right, self.stereo)
                 except MeasurementError as exc:
                     self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
                     continue
@@ -346,7 +348,7 @@ class Runner(Motion):
         clock.lap("settle_s")
         pair = self.camera.capture()
         clock.lap("capture_s")
-        result, meas = inspect_hole(self.cell, self.geometry, self.model, self.camera.stereo,
+        result, meas = inspect_hole(self.cell, self.geometry, self.model, self.stereo,
                                self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
                                st.temperatures_c, st.time_s, self.budget)  # fmt: skip
         result = replace(result, thermal_model_id=self.model_id if self.model else None)

@@ -10,7 +10,8 @@ a per-view flange scatter are added, and the adjustment
 (:func:`cell.calibration.solve.solve_calibration`) estimates the calibration from them with
 the provenance of the run's cell. What this leaves out against a calibration from rendered
 images (``calibrate_cell``): the corner detector's errors, the time to drive the tour, and
-the true head's intrinsics being off its stereo file (the projection uses the file's).
+the true head's intrinsics being off its stereo file (the projection uses the file's; the
+right camera's pose it takes from the true head when given one).
 """
 
 from __future__ import annotations
@@ -34,18 +35,26 @@ from robots.transforms import invert
 SCATTER_LEVER_M = 0.5
 
 
-def synthetic_truth(cell: CellConfig, geometry: TrueGeometry, stereo: StereoCalibration):
-    """The simulated cell's truth as :class:`cell.calibration.synthetic.SyntheticTruth`."""
+def synthetic_truth(
+    cell: CellConfig,
+    geometry: TrueGeometry,
+    stereo: StereoCalibration,
+    true_stereo: StereoCalibration | None = None,
+) -> SyntheticTruth:
+    """The simulated cell's truth as :class:`cell.calibration.synthetic.SyntheticTruth`:
+    the intrinsics of ``stereo`` (the file's, as the adjustment takes them), the right camera
+    where ``true_stereo`` (the simulated head as it truly is) puts it, else the file's."""
     if cell.calibration_target is None or geometry.T_cell_target is None:
         raise CellError(f"{cell.name}: the cell file has no calibration_target")
     nominal = cell.build_robot().dh
     true_rows = np.array(geometry.table.arrays()).T  # (6, 4): a, d, alpha, theta offset
     delta = (true_rows - np.array(nominal.arrays()).T).ravel()
     cameras = Cameras.from_stereo(stereo)
+    true_lr = Cameras.from_stereo(true_stereo).T_left_right if true_stereo else None
     state = State(
         T_tool0_camera=geometry.T_tool0_camera_left,
         T_base_target=invert(geometry.T_cell_base) @ geometry.T_cell_target,
-        T_left_right=cameras.T_left_right,
+        T_left_right=cameras.T_left_right if true_lr is None else true_lr,
         delta=delta,
     )
     return SyntheticTruth(nominal, cameras, state, cell.T_tool0_tcp() @ head_frame(stereo),
@@ -79,10 +88,12 @@ def simulated_calibration(
     q_views: np.ndarray,
     noise_px: float = 0.1,
     seed: int = 0,
+    true_stereo: StereoCalibration | None = None,
 ) -> CalibrationResult:
     """The calibration of the simulated cell from views at joints ``q_views`` (V, 6) (see
-    the module docstring); raises the adjustment's refusals."""
-    truth = synthetic_truth(cell, geometry, stereo)
+    the module docstring; ``true_stereo``: the simulated head as it truly is, whose right
+    camera the projection uses); raises the adjustment's refusals."""
+    truth = synthetic_truth(cell, geometry, stereo, true_stereo)
     q = np.asarray(q_views, float)
     s = sigma_per_axis_m(repeatability_rp_m)
     obs = simulate(truth, q, noise_px, seed=seed + 1, flange_sigma_m=s,
