@@ -194,3 +194,25 @@ def test_the_calibration_is_stored_with_the_run(calibrated, tmp_path: Path) -> N
     assert info["file"] == str(dest) and info["created_utc"] == cal.created_utc
     assert len(info["sigma_hand_eye_xyz_m"]) == 3
     assert calibration_summary(tmp_path / "nothing") is None
+
+
+def test_the_run_triangulates_with_the_calibrated_stereo_extrinsics(
+    small_cell: SmallCell, calibrated
+) -> None:
+    """The calibration's ``T_left_right`` replaces the file's; the intrinsics stay the file's,
+    and the calibrated TCP still carries the left camera to the calibrated hand-eye."""
+    from cell.run.calibration import calibrated_stereo
+
+    path, _, cal = calibrated
+    cell = small_cell.cell
+    st = cell_stereo(cell)
+    rc = _load(path, cell)
+    st2 = calibrated_stereo(st, rc)
+    T_rl = invert(cal.T_left_right.T)
+    np.testing.assert_allclose(st2.R, T_rl[:3, :3], atol=1e-12)
+    np.testing.assert_allclose(st2.T, T_rl[:3, 3], atol=1e-12)
+    np.testing.assert_array_equal(st2.K_left, st.K_left)
+    assert calibrated_stereo(st, None) is st
+    geo = RunGeometry(cell.build_arm(), st2, rc)
+    X = geo.T_tool0_tcp @ invert(head_frame(st2))
+    np.testing.assert_allclose(X, cal.T_tool0_camera.T, atol=1e-12)
