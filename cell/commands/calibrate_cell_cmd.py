@@ -88,6 +88,7 @@ def run(args: argparse.Namespace) -> int:
     from cell.calibration.solve import SolveOptions
     from cell.calibration_run import CalibrateCellOptions, CaptureSettings, run_calibration_tour
     from cell.calibration_run.plan import calibrate_plan_options, plan_cell_calibration
+    from cell.calibration_run.run import check_calibration_tour
     from cell.commands.calibrate_report import print_result
     from cell.config import load_cell
     from cell.errors import CellError
@@ -107,6 +108,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"planning {args.views} calibration views ...", flush=True)
         tour = plan_cell_calibration(cell, stereo, calibrate_plan_options(args.views, args.seed))
         source = f"the planned calibration tour ({args.views} views)"
+    check_calibration_tour(cell, tour, source)  # before the arm moves
     options = CalibrateCellOptions(
         capture=CaptureSettings(settle_s=args.settle_s, max_edge_width_px=args.max_edge_width),
         solve=replace(
