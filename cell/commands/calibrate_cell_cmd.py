@@ -55,6 +55,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="take the stereo extrinsics from the stereo calibration as exact",
     )  # fmt: skip
     p.add_argument("--no-kinematics", action="store_true", help="do not estimate D-H errors")
+    p.add_argument(
+        "--fixed-intrinsics", action="store_true",
+        help="take both cameras' fx, fy, cx, cy from the stereo calibration as exact (default: "
+        "estimate their corrections with the rest, marginalised; docs/calibration.md)",
+    )  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)
 
@@ -115,6 +120,7 @@ def run(args: argparse.Namespace) -> int:
             SolveOptions(),
             estimate_kinematics=not args.no_kinematics,
             estimate_stereo=not args.fixed_stereo,
+            estimate_intrinsics=not args.fixed_intrinsics,
         ),
     )
     client = ControllerClient(args.port)
