@@ -152,7 +152,10 @@ def main() -> None:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--views", type=int, default=120)
     ap.add_argument("--tour", type=Path, default=None, help="caltour.json (default: planned)")
-    ap.add_argument("--speed", type=float, default=20.0, help="simulation speed")
+    ap.add_argument(
+        "--speed", type=float, default=1.0,
+        help="simulation speed (1: the detection overlaps the moves as in the cell)",
+    )  # fmt: skip
     ap.add_argument("--cache", type=Path, default=None, help="folder for captures and tour")
     ap.add_argument("--variant", choices=[*VARIANTS, "both"], default="both")
     args = ap.parse_args()
