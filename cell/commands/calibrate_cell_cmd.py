@@ -55,6 +55,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="take the stereo extrinsics from the stereo calibration as exact",
     )  # fmt: skip
     p.add_argument("--no-kinematics", action="store_true", help="do not estimate D-H errors")
+    p.add_argument(
+        "--fixed-intrinsics", action="store_true",
+        help="take both cameras' fx, fy, cx, cy from the stereo calibration as exact (default: "
+        "estimate their corrections with the rest, marginalised; docs/calibration.md)",
+    )  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)
 
@@ -88,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
     from cell.calibration.solve import SolveOptions
     from cell.calibration_run import CalibrateCellOptions, CaptureSettings, run_calibration_tour
     from cell.calibration_run.plan import calibrate_plan_options, plan_cell_calibration
+    from cell.calibration_run.run import check_calibration_tour
     from cell.commands.calibrate_report import print_result
     from cell.config import load_cell
     from cell.errors import CellError
@@ -107,12 +113,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"planning {args.views} calibration views ...", flush=True)
         tour = plan_cell_calibration(cell, stereo, calibrate_plan_options(args.views, args.seed))
         source = f"the planned calibration tour ({args.views} views)"
+    check_calibration_tour(cell, tour, source)  # before the arm moves
     options = CalibrateCellOptions(
         capture=CaptureSettings(settle_s=args.settle_s, max_edge_width_px=args.max_edge_width),
         solve=replace(
             SolveOptions(),
             estimate_kinematics=not args.no_kinematics,
             estimate_stereo=not args.fixed_stereo,
+            estimate_intrinsics=not args.fixed_intrinsics,
         ),
     )
     client = ControllerClient(args.port)

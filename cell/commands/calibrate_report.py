@@ -56,6 +56,12 @@ def print_result(result: CalibrationResult) -> None:
             for t in free
         )
         print(f"D-H errors (mm, deg): {terms}")
+    if result.intrinsics:
+        shown = ", ".join(f"{n.removeprefix('intrinsics.')} {v:+.2f}±{e:.2f}"
+                          for n, (v, e) in result.intrinsics.items())  # fmt: skip
+        print(
+            f"intrinsic corrections (px, estimated with the rest; stereo.json unchanged): {shown}"
+        )
     for name, reason in result.report.fixed.items():
         print(f"  fixed {name}: {reason}")
     print(
