@@ -26,7 +26,7 @@ import numpy as np
 
 from cell.calibration.modelfile import save_calibration
 from cell.calibration.result import CellCalibration
-from cell.calibration.solve import pose_error
+from cell.calibration.solve import SolveOptions, pose_error
 from cell.calibration.synthetic import truth_in_gauge
 from cell.config import CellConfig
 from cell.run.calibration import RUN_FILENAME
@@ -112,7 +112,10 @@ def calibrate_demo_cell_images(
     t0 = time.perf_counter()
     sim.world.clock.set_speed(speed)
     try:
-        opts = CalibrateCellOptions(capture=CaptureSettings(settle_s=0.2 / speed))
+        opts = CalibrateCellOptions(
+            capture=CaptureSettings(settle_s=0.2 / speed),
+            solve=SolveOptions(estimate_intrinsics=True),
+        )  # as the CLI
         with ControllerClient(sim.url) as client:
             run = run_calibration_tour(cell, caltour, client, sim.camera, opts)
     finally:
