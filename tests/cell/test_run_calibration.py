@@ -216,3 +216,25 @@ def test_the_run_triangulates_with_the_calibrated_stereo_extrinsics(
     geo = RunGeometry(cell.build_arm(), st2, rc)
     X = geo.T_tool0_tcp @ invert(head_frame(st2))
     np.testing.assert_allclose(X, cal.T_tool0_camera.T, atol=1e-12)
+
+
+def test_a_resumed_run_uses_the_copy_it_stored(small_cell: SmallCell, calibrated, tmp_path):
+    """``--resume`` reads RUN_DIR/cellcal.json (its age is not checked again) and refuses a
+    new ``--calibration``; a run that stored none resumes without."""
+    import argparse
+
+    from cell.calibration.apply import CalibratedKinematics
+    from cell.calibration.modelfile import load_calibration
+    from cell.commands.run_cmd import _calibration
+    from cell.errors import CellError
+    from cell.run.calibration import RunCalibration
+
+    path, _, _ = calibrated
+    cal = load_calibration(path)
+    store_calibration(RunCalibration(cal, CalibratedKinematics(cal), str(path)), tmp_path)
+    args = argparse.Namespace(calibration=None, calibration_max_age=0.0)  # any age would fail
+    rc = _calibration(args, small_cell.cell, tmp_path)
+    assert rc is not None and rc.source == str(tmp_path / "cellcal.json")
+    assert _calibration(args, small_cell.cell, tmp_path / "none") is None
+    with pytest.raises(CellError, match="--resume uses the calibration stored with the run"):
+        _calibration(argparse.Namespace(calibration=str(path)), small_cell.cell, tmp_path)
