@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cell.calibration_run.orient import orient_chessboard, refine_corners
+from cell.calibration_run.orient import orient_chessboard, refine_corners, repair_outliers
 from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.run.camera import CameraBackend
@@ -119,20 +119,27 @@ class TourCapture(Motion):
             self._safe_stop()
             raise
 
-    def _detect(self, image: np.ndarray) -> tuple[Array | None, str]:
-        """The target's features in the board's order (:mod:`.orient`), or why not found."""
+    def _detect(self, image: np.ndarray, side: str) -> tuple[Array | None, str]:
+        """The target's features in the board's order (:mod:`.orient`), refined, a corner off
+        the plate's plane refined again; or why not found."""
         det = find_target(image, self.target, self.options.max_edge_width_px)
         if det.points is None:
             return None, det.reason
         pts = orient_chessboard(image, det.points, self.target)
-        return refine_corners(image, pts, self.target), ""
+        pts = refine_corners(image, pts, self.target)
+        if self.target.kind != "chessboard":
+            return pts, ""
+        st = self.camera.stereo
+        K, dist = (st.K_left, st.dist_left) if side == "left" else (st.K_right, st.dist_right)
+        pts, why = repair_outliers(image, pts, self.target, K, dist)
+        return (None, why) if why else (pts, "")
 
     def _detect_pair(
         self, pair
     ) -> tuple[tuple[Array | None, str], tuple[Array | None, str], float]:
         """Both images' features (or why not) and the wall time the detection took (s)."""
         t = time.perf_counter()
-        left, right = self._detect(pair.left), self._detect(pair.right)
+        left, right = self._detect(pair.left, "left"), self._detect(pair.right, "right")
         return left, right, time.perf_counter() - t
 
     def _run(self) -> TourCaptures:

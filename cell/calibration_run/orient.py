@@ -87,3 +87,48 @@ def refine_corners(gray: NDArray, points_px: Array, spec: TargetSpec) -> Array:
     pts = np.asarray(points_px, np.float32).reshape(-1, 1, 2).copy()
     out = cv2.cornerSubPix(to_gray8(gray), pts, (half, half), (-1, -1), crit)
     return out.reshape(-1, 2).astype(np.float64)
+
+
+#: a corner farther than this from the plane the others fit (px) is detected wrongly
+PLANE_TOLERANCE_PX = 2.0
+
+
+def plane_outliers(
+    points_px: Array, spec: TargetSpec, K: Array, dist: Array
+) -> tuple[Array, Array]:
+    """Each corner's distance (px) from the board plane the others fit, and the plane's
+    prediction of every corner (px): the corners undistorted with the camera's lens, a
+    homography from the board fitted robustly (RANSAC, 1 px), mapped back through the lens.
+    An intrinsic error of a pixel or two moves every corner alike and does not show."""
+    obj = spec.object_points()[:, :2].astype(np.float64)
+    pts = np.asarray(points_px, np.float64).reshape(-1, 1, 2)
+    norm = cv2.undistortPoints(pts, K, dist).reshape(-1, 2)
+    f = float(K[0, 0])
+    H, _mask = cv2.findHomography(obj, norm * f, cv2.RANSAC, 1.0)
+    if H is None:
+        return np.full(len(obj), np.inf), np.asarray(points_px, float)
+    pred = cv2.perspectiveTransform(obj.reshape(-1, 1, 2), H).reshape(-1, 2) / f
+    rays = np.column_stack([pred, np.ones(len(pred))])
+    px = cv2.projectPoints(rays, np.zeros(3), np.zeros(3), K, dist)[0].reshape(-1, 2)
+    return np.linalg.norm(px - np.asarray(points_px, float), axis=1), px
+
+
+def repair_outliers(
+    gray: NDArray, points_px: Array, spec: TargetSpec, K: Array, dist: Array
+) -> tuple[Array, str]:
+    """Corners off the board's plane (:func:`plane_outliers`) refined again from the plane's
+    prediction (the detector's 5 px half window); ``(corners, "")`` or, when one stays off,
+    the reason ("corner 1 is 27.0 px off the plate's plane")."""
+    off, pred = plane_outliers(points_px, spec, K, dist)
+    bad = np.flatnonzero(off > PLANE_TOLERANCE_PX)
+    if len(bad) == 0:
+        return points_px, ""
+    out = np.asarray(points_px, float).copy()
+    crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 100, 1e-5)
+    start = pred[bad].astype(np.float32).reshape(-1, 1, 2).copy()
+    out[bad] = cv2.cornerSubPix(to_gray8(gray), start, (5, 5), (-1, -1), crit).reshape(-1, 2)
+    off, _ = plane_outliers(out, spec, K, dist)
+    worst = int(np.argmax(off))
+    if off[worst] > PLANE_TOLERANCE_PX:
+        return out, f"corner {worst + 1} is {off[worst]:.1f} px off the plate's plane"
+    return out, ""

@@ -40,10 +40,13 @@ from planner.calibration import CalibrationTour
 @dataclass(frozen=True)
 class CalibrateCellOptions:
     """Settings of :func:`calibrate_cell`: the motion and detection (``capture``) and the
-    adjustment (``solve``; the stereo extrinsics and the D-H terms are estimated by default)."""
+    adjustment (``solve``; the stereo extrinsics, the D-H terms and the cameras' intrinsic
+    corrections are estimated by default: with the intrinsics taken as exact the TCP error
+    after calibration was 43.5 um RMS on seed 0 with 120 views, with them estimated 19.8 um,
+    docs/calibration.md)."""
 
     capture: CaptureSettings = field(default_factory=CaptureSettings)
-    solve: SolveOptions = field(default_factory=SolveOptions)
+    solve: SolveOptions = field(default_factory=lambda: SolveOptions(estimate_intrinsics=True))
 
 
 @dataclass(frozen=True, eq=False)

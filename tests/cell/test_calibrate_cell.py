@@ -199,3 +199,23 @@ def test_calibrate_cell_full_head_30_views(tmp_path: Path, capsys) -> None:
     tr = true_state(cell.build_robot().dh, sim.camera.geometry, invert(T_rl), 0.0)
     dp, da = pose_error(cal.T_tool0_camera.T, tr.T_tool0_camera)
     assert dp < 0.15e-3 and np.degrees(da) < 0.02, (dp, np.degrees(da))
+
+
+def test_a_corner_off_the_plate_plane_is_refined_again() -> None:
+    from cell.calibration_run.orient import plane_outliers, repair_outliers
+
+    spec = load_cell(None).calibration_target.target_spec()
+    st = toed_in_stereo(image_size=SMALL_SIZE, pixel_m=4 * STANDARD_PIXEL_M)
+    P = spec.object_points()
+    T = np.eye(4)
+    T[:3, 3] = np.array([0.0, 0.0, 0.25]) - 0.5 * (P.min(axis=0) + P.max(axis=0))
+    r = render_target_pair(st, spec, T, supersample=1, seed=2)
+    det = find_target(r.left, spec)
+    good = refine_corners(r.left, orient_chessboard(r.left, det.points, spec), spec)
+    assert plane_outliers(good, spec, st.K_left, st.dist_left)[0].max() < 1.0
+    bad = good.copy()
+    bad[0] += (6.0, -5.0)  # a corner the detector put on the wrong spot
+    off, _ = plane_outliers(bad, spec, st.K_left, st.dist_left)
+    assert off[0] > 5.0 and np.delete(off, 0).max() < 1.0
+    fixed, why = repair_outliers(r.left, bad, spec, st.K_left, st.dist_left)
+    assert why == "" and np.linalg.norm(fixed[0] - good[0]) < 0.5
