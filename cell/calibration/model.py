@@ -30,6 +30,9 @@ from robots.dh import DHTable
 Array = NDArray[np.float64]
 
 POSE_COLUMNS = ("x_m", "y_m", "z_m", "rx_rad", "ry_rad", "rz_rad")
+#: the intrinsic corrections of one camera (px), added to its ``K``
+INTRINSIC_COLUMNS = ("fx_px", "fy_px", "cx_px", "cy_px")
+N_INTRINSIC = len(INTRINSIC_COLUMNS)
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,17 +43,37 @@ class State:
     T_base_target: Array
     T_left_right: Array | None
     delta: Array
+    intrinsics: Array | None = None  # corrections (px) fx, fy, cx, cy of left (and right)
 
 
-def column_names(stereo: bool, kinematic: bool) -> tuple[str, ...]:
-    """Names of the Jacobian's columns (see the module docstring)."""
+def column_names(stereo: bool, kinematic: bool, intrinsics: bool = False) -> tuple[str, ...]:
+    """Names of the Jacobian's columns (see the module docstring); ``intrinsics``: the
+    corrections of each camera's fx, fy, cx, cy (px) last."""
     names = [f"T_tool0_camera.{c}" for c in POSE_COLUMNS]
     names += [f"T_base_target.{c}" for c in POSE_COLUMNS]
     if stereo:
         names += [f"T_left_right.{c}" for c in POSE_COLUMNS]
     if kinematic:
         names += [f"dh.{n}" for n in term_names()]
+    if intrinsics:
+        for side in ("left", "right") if stereo else ("left",):
+            names += [f"intrinsics.{side}.{c}" for c in INTRINSIC_COLUMNS]
     return tuple(names)
+
+
+def intrinsic_names(stereo: bool) -> tuple[str, ...]:
+    """The intrinsic correction columns of a head (stereo: left then right)."""
+    return tuple(c for c in column_names(stereo, False, True) if c.startswith("intrinsics."))
+
+
+def corrected(cam: Intrinsics, d: Array) -> Intrinsics:
+    """``cam`` with ``d`` = (fx, fy, cx, cy) corrections (px) added to its ``K``."""
+    K = cam.K.copy()
+    K[0, 0] += d[0]
+    K[1, 1] += d[1]
+    K[0, 2] += d[2]
+    K[1, 2] += d[3]
+    return Intrinsics(K, cam.dist, cam.image_size)
 
 
 def _skew(v: Array) -> Array:
@@ -78,6 +101,10 @@ def step_state(state: State, x: Array, columns: tuple[str, ...]) -> State:
         return np.array([full.get(f"{prefix}.{c}", 0.0) for c in POSE_COLUMNS])
 
     delta = state.delta + np.array([full.get(f"dh.{n}", 0.0) for n in term_names()])
+    intr = state.intrinsics
+    if intr is not None:
+        names = intrinsic_names(len(intr) == 2 * N_INTRINSIC)
+        intr = intr + np.array([full.get(n, 0.0) for n in names])
     return replace(
         state,
         T_tool0_camera=perturb_pose(state.T_tool0_camera, block("T_tool0_camera")),
@@ -88,6 +115,7 @@ def step_state(state: State, x: Array, columns: tuple[str, ...]) -> State:
             else perturb_pose(state.T_left_right, block("T_left_right"))
         ),
         delta=delta,
+        intrinsics=intr,
     )
 
 
@@ -98,12 +126,13 @@ def flange_poses(obs: CalibrationObservations, dh: DHTable | None, delta: Array)
     return np.array([np.asarray(v.T_base_tool0, float) for v in obs.views])
 
 
-def _project(X: Array, cam: Intrinsics, jac: bool) -> tuple[Array, Array | None]:
-    """Pixels (N, 2) of camera points (N, 3) and d pixel / d X (N, 2, 3)."""
+def _project(X: Array, cam: Intrinsics, jac: bool) -> tuple[Array, Array | None, Array | None]:
+    """Pixels (N, 2) of camera points (N, 3), d pixel / d X (N, 2, 3) and d pixel / d (fx, fy,
+    cx, cy) (2N, 4)."""
     px, J = cv2.projectPoints(X.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), cam.K, cam.dist)
     if not jac:
-        return px.reshape(-1, 2), None
-    return px.reshape(-1, 2), J[:, 3:6].reshape(-1, 2, 3)
+        return px.reshape(-1, 2), None, None
+    return px.reshape(-1, 2), J[:, 3:6].reshape(-1, 2, 3), J[:, 6:10]
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,7 +164,8 @@ def predict(
     ``flange_jac`` also the Jacobian of each row against its view's flange pose error."""
     kinematic = dh is not None and obs.has_joints
     stereo = obs.cameras.stereo and state.T_left_right is not None
-    cols = column_names(stereo, kinematic)
+    cols = column_names(stereo, kinematic)  # the geometric columns; the intrinsics follow
+    n_intr = 0 if state.intrinsics is None else N_INTRINSIC * (2 if stereo else 1)
     p = obs.target.object_points()  # (M, 3)
     T_bt = flange_poses(obs, dh, state.delta)  # (V, 4, 4)
     R_bt, t_bt = T_bt[:, :3, :3], T_bt[:, :3, 3]
@@ -170,7 +200,10 @@ def predict(
     sides = [("left", obs.cameras.left)]
     if stereo:
         sides.append(("right", obs.cameras.right))
-    for side, cam in sides:
+    if state.intrinsics is not None:
+        sides = [(side, corrected(cam, state.intrinsics[4 * i : 4 * i + 4]))
+                 for i, (side, cam) in enumerate(sides)]  # fmt: skip
+    for i_side, (side, cam) in enumerate(sides):
         corners, seen = obs.corners(side)
         if not seen.any():
             continue
@@ -184,19 +217,22 @@ def predict(
                 Ds[..., 12:15] = -R_L.T
                 Ds[..., 15:18] = np.einsum("ji,vmjk->vmik", R_L, _skew(z))
             Xs = z @ R_L
-        px, Jp = _project(Xs.reshape(-1, 3), cam, Ds is not None)
+        px, Jp, Jk = _project(Xs.reshape(-1, 3), cam, Ds is not None)
         rows_r.append((px - corners[seen].reshape(-1, 2)).reshape(-1))
         if Ds is not None:
-            rows_J.append(
-                np.einsum("nij,njk->nik", Jp, Ds.reshape(-1, 3, n_cols)).reshape(-1, n_cols)
-            )
+            geo = np.einsum("nij,njk->nik", Jp, Ds.reshape(-1, 3, n_cols)).reshape(-1, n_cols)
+            intr = np.zeros((len(geo), n_intr))
+            if n_intr:
+                intr[:, 4 * i_side : 4 * i_side + 4] = Jk
+            rows_J.append(np.hstack([geo[:, : len(cols)], intr, geo[:, len(cols) :]]))
         views.append(np.repeat(np.flatnonzero(seen), M))
         cams.append(np.full(int(seen.sum()) * M, side))
     J_all = np.concatenate(rows_J) if rows_J else None
+    k = len(cols) + n_intr
     return Prediction(
         residuals=np.concatenate(rows_r),
-        jacobian=J_all[:, : len(cols)] if jac else None,
+        jacobian=J_all[:, :k] if jac else None,
         view_index=np.concatenate(views),
         camera=np.concatenate(cams),
-        flange_jacobian=J_all[:, len(cols) :] if flange_jac else None,
+        flange_jacobian=J_all[:, k:] if flange_jac else None,
     )

@@ -37,7 +37,15 @@ from cell.calibration.covariance import (
 from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationError
 from cell.calibration.identifiability import IdentifiabilityReport, choose_free
 from cell.calibration.initial import InitialEstimate, initial_estimate
-from cell.calibration.model import State, column_names, flange_poses, predict, step_state
+from cell.calibration.model import (
+    N_INTRINSIC,
+    State,
+    column_names,
+    flange_poses,
+    intrinsic_names,
+    predict,
+    step_state,
+)
 from cell.calibration.observations import CalibrationObservations
 from cell.calibration.refusals import check_views
 from cell.calibration.result import (
@@ -74,6 +82,11 @@ class SolveOptions:
         max_dh_length_m, max_dh_angle_rad: largest plausible D-H length and angle error; a
             fit beyond says the joints belong to another arm (or another joint zero) than the
             nominal table, and is refused.
+        estimate_intrinsics: estimate corrections of each camera's fx, fy, cx, cy (px) with
+            the rest, as nuisance unknowns: the other estimates are then free of the stereo
+            calibration's intrinsic error and their covariance holds the intrinsics'
+            uncertainty (marginalised); the corrections are reported in the notes, not
+            written as estimates (the run measures with stereo.json).
     """
 
     estimate_kinematics: bool = True
@@ -89,6 +102,7 @@ class SolveOptions:
     flange_scatter: bool = True
     flange_sigma_m: float | None = None
     flange_sigma_rad: float | None = None
+    estimate_intrinsics: bool = False
 
     def __post_init__(self) -> None:
         if not self.max_condition > 1.0:
@@ -107,6 +121,7 @@ class CalibrationResult:
     report: IdentifiabilityReport
     initial: InitialEstimate | None
     timings: dict[str, float] = field(default_factory=dict)
+    intrinsics: dict[str, tuple[float, float]] = field(default_factory=dict)
 
 
 def _left_jacobian(w: Array) -> Array:
@@ -127,7 +142,7 @@ class _Problem:
         self.obs, self.dh, self.start, self.free = obs, dh, start, free
         stereo = start.T_left_right is not None
         kinematic = dh is not None and obs.has_joints
-        self.columns = column_names(stereo, kinematic)
+        self.columns = column_names(stereo, kinematic, start.intrinsics is not None)
         self.idx = [self.columns.index(c) for c in free]
         self._x: Array | None = None
         self._pred = None
@@ -206,7 +221,9 @@ def solve_calibration(
     t_init = time.perf_counter()
     stereo = start.T_left_right is not None
     kinematic = dh is not None and obs.has_joints
-    columns = column_names(stereo, kinematic)
+    if opts.estimate_intrinsics and start.intrinsics is None:
+        start = replace(start, intrinsics=np.zeros(N_INTRINSIC * (2 if stereo else 1)))
+    columns = column_names(stereo, kinematic, start.intrinsics is not None)
     # a first fit of the poses alone puts the rank test at a good linearisation point
     poses = tuple(c for c in columns if not c.startswith("dh."))
     if not opts.estimate_stereo:
@@ -225,7 +242,7 @@ def solve_calibration(
     if n <= p:
         raise DegenerateCalibrationError(f"{n} corner coordinates for {p} unknowns")
     if opts.flange_scatter:
-        n_stereo = sum(c.startswith("T_left_right.") for c in report.free)
+        n_stereo = sum(c.startswith(("T_left_right.", "intrinsics.")) for c in report.free)
         rows_view = np.repeat(pred.view_index, 2)
         cr = flange_scatter_covariance(
             Jf,
@@ -249,12 +266,18 @@ def solve_calibration(
     else:
         cr = white_covariance(Jf, pred.residuals)
     t_end = time.perf_counter()
+    report, cr, intrinsics = _marginal_intrinsics(report, cr, state)
     cal = build_calibration(obs, dh, state, report, cr, pred, provenance or Provenance(), init)
+    if intrinsics:
+        shown = ", ".join(f"{n[len('intrinsics.') :]} {v:+.2f}±{s:.2f}"
+                          for n, (v, s) in intrinsics.items())  # fmt: skip
+        cal = replace(cal, notes=(*cal.notes, f"intrinsics corrected (px, marginalised): {shown}"))
     return CalibrationResult(
         status="calibrated",
         calibration=cal,
         report=report,
         initial=init,
+        intrinsics=intrinsics,
         timings={
             "initial_s": t_init - t0,
             "rank_s": t_rank - t_init,
@@ -262,6 +285,22 @@ def solve_calibration(
             "total_s": t_end - t0,
         },
     )
+
+
+def _marginal_intrinsics(report: IdentifiabilityReport, cr, state: State):
+    """The report and covariance without the intrinsic corrections (their marginal: the
+    sub-block of the others), and the corrections' values and sigmas (px) by name."""
+    names = [c for c in report.free if c.startswith("intrinsics.")]
+    if not names:
+        return report, cr, {}
+    keep = [i for i, c in enumerate(report.free) if not c.startswith("intrinsics.")]
+    cov = cr.covariance
+    stereo = len(state.intrinsics) == 2 * N_INTRINSIC
+    values = dict(zip(intrinsic_names(stereo), state.intrinsics, strict=True))
+    out = {n: (float(values[n]), float(np.sqrt(cov[report.free.index(n)] [report.free.index(n)])))
+           for n in names}  # fmt: skip
+    report = replace(report, free=tuple(report.free[i] for i in keep))
+    return report, replace(cr, covariance=cov[np.ix_(keep, keep)]), out
 
 
 def _check_plausible(

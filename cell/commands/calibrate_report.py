@@ -59,6 +59,12 @@ def print_result(result: CalibrationResult) -> None:
     free = [t for t in cal.dh_terms if t.free]
     if free:
         print(f"D-H errors: {', '.join(dh_term_text(t.name, t.value, t.sigma) for t in free)}")
+    if result.intrinsics:
+        shown = ", ".join(f"{n.removeprefix('intrinsics.')} {v:+.2f}±{e:.2f}"
+                          for n, (v, e) in result.intrinsics.items())  # fmt: skip
+        print(
+            f"intrinsic corrections (px, estimated with the rest; stereo.json unchanged): {shown}"
+        )
     for name, reason in result.report.fixed.items():
         print(f"  fixed {name}: {reason}")
     print(
