@@ -40,7 +40,7 @@ def options(seed: int, variant: str) -> DemoOptions:
     """The demo's options of one seed and variant."""
     cell = load_builtin_cell()
     truth = CellTruth.drawn(seed, cell)
-    opts = DemoOptions(seed=seed, truth=truth)
+    opts = DemoOptions(seed=seed, truth=truth, calibration_method="projected")
     if variant == "no-calibration":
         return replace(opts, calibrate=False)
     if variant == "no-repeatability":

@@ -72,12 +72,13 @@ class DemoOptions:
         calibrate: run the cell calibration on the simulated cell first and measure the part
             with it (False: ``--no-calibration``, the nominal kinematics).
         calibration_views: views of the plate of that calibration.
-        calibration_method: ``"projected"`` (default): the plate's corners projected at the
-            planner's views (seconds; :mod:`cell.run.demo_calibrate`); ``"images"``: the
-            calibration tour driven on the simulated cell, the plate rendered and detected
-            (``calibrate cell``'s procedure; minutes while the plate renders slowly).
+        calibration_method: ``"images"`` (default): the calibration tour driven on the
+            simulated cell, the plate rendered and detected in both cameras (``calibrate
+            cell``'s procedure; about a minute for 120 views); ``"projected"``: the plate's
+            corners projected at the planner's views (seconds, no detector; for benchmarks
+            over many seeds, :mod:`cell.run.demo_calibrate`).
         calibration_speed: simulation speed while the calibration tour is driven (the
-            simulated arm warms with the simulated time, so 1: the tour's real time).
+            simulated arm warms with the simulated time, whatever the speed).
         truth: every hidden error of the simulated cell (a truth file, ``--truth``); None:
             the drawn truth above (or, without ``geometry_errors``, no geometric error).
         decision_rule: the run's decision rule.
@@ -97,8 +98,8 @@ class DemoOptions:
     geometry_errors: bool = True
     calibrate: bool = True
     calibration_views: int = 120
-    calibration_method: str = "projected"
-    calibration_speed: float = 1.0
+    calibration_method: str = "images"
+    calibration_speed: float = 5.0
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
     truth: CellTruth | None = None
