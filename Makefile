@@ -3,6 +3,8 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+# test processes (pytest-xdist): the suite waits on simulated real time, so two share 2 cores well
+JOBS ?= 2
 
 .PHONY: demo test lint format bench clean
 
@@ -16,7 +18,7 @@ demo: $(STAMP)
 	$(VENV)/bin/holecell demo
 
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(JOBS)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check cell planner measure robots tests benchmarks examples
