@@ -17,6 +17,10 @@ from cell.sim.camera import SimCamera
 log = logging.getLogger(__name__)
 
 
+#: longest wait for one stereo pair to be taken up by the client (s)
+SEND_TIMEOUT_S = 30.0
+
+
 class CameraServer:
     """Serves a :class:`SimCamera` on ``tcp://127.0.0.1:PORT`` (``url``) in a daemon thread."""
 
@@ -72,11 +76,15 @@ class CameraServer:
             while b"\n" in buf:
                 line, buf = buf.split(b"\n", 1)
                 if line.strip() == b"CAPTURE":
+                    # the short timeout is for noticing a stop between requests; a pair of
+                    # megabytes to a busy client may take longer than that to send
+                    conn.settimeout(SEND_TIMEOUT_S)
                     try:
                         self._answer(conn)
                     except OSError as exc:  # the client went away mid-transfer
                         log.info("camera client lost: %s", exc)
                         return
+                    conn.settimeout(0.2)
 
     def _answer(self, conn: socket.socket) -> None:
         try:
