@@ -48,7 +48,7 @@ def placement_of(mm: float, deg: float) -> np.ndarray:
 def one_run(out: Path, seed: int, T_err: np.ndarray | None) -> tuple[dict, dict]:
     """A demo; its report.json and the true characteristics' coverage."""
     cell = load_builtin_cell()
-    opts = DemoOptions(seed=seed)
+    opts = DemoOptions(seed=seed, geometry_errors=False, calibrate=False)  # the placement alone
     truth = demo_truth(cell, opts)
     if T_err is not None:
         truth = replace(truth, part_placement_error=T_err)

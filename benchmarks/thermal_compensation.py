@@ -33,7 +33,8 @@ import time
 
 import numpy as np
 
-from robots.dh import DHTable, dh_table, fk_dh
+from robots.dh import DHTable, fk_dh
+from robots.dh_models import dh_table
 from robots.models import MODELS
 from robots.thermal import (
     CellGeometry,

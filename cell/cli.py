@@ -1,7 +1,8 @@
 """The ``holecell`` command line: one subcommand module each under :mod:`cell.commands`.
 
 User mistakes (every package's error base, and missing files) are printed as one
-clear message on stderr with exit code 2, never as a traceback.
+clear message on stderr with exit code 2, never as a traceback; so are mistakes on the command
+line itself (argparse's usage block is left out: ``--help`` shows it).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import logging
 import os
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 #: subcommand modules under ``cell.commands``, in the order ``--help`` lists them
 COMMAND_MODULES: tuple[str, ...] = (
@@ -74,9 +76,19 @@ def _modules_for(argv: Sequence[str] | None) -> tuple[str, ...]:
     return mine if asked is not None and len(mine) == 1 else COMMAND_MODULES
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose command-line errors are one line (exit 2), pointing at
+    ``--help`` instead of printing the usage block; its subcommands' parsers are of this class
+    too (``add_subparsers`` takes the parent's class)."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print ``PROG: error: MESSAGE (see PROG --help)`` on stderr and exit 2."""
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The argument parser with the subcommand ``argv`` names (every subcommand without one)."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="holecell",
         description="Robot-vision hole inspection cells: plan tours, run them, measure holes.",
     )

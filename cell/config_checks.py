@@ -14,7 +14,7 @@ from robots import LimitsError, RobotModelError
 from robots.meshes import MeshFileError
 
 if TYPE_CHECKING:
-    from cell.config import CellConfig
+    from cell.config_schema import CellConfig
 
 Problem = tuple[str, object, str]
 

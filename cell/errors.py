@@ -7,13 +7,21 @@ class CellError(Exception):
     """Base of every error raised by :mod:`cell`. The CLI prints its message, no traceback."""
 
 
+#: the value of a :class:`ConfigError` problem that has none to show (a YAML syntax error)
+NO_VALUE: object = type("NoValue", (), {"__repr__": lambda self: "NO_VALUE"})()
+
+
 class ConfigError(CellError):
-    """A cell file is invalid. ``problems`` lists ``(field path, value, message)``."""
+    """A cell file is invalid. ``problems`` lists ``(field path, value, message)``; one line
+    each, without the value when it is :data:`NO_VALUE`."""
 
     def __init__(self, path: str, problems: list[tuple[str, object, str]]) -> None:
         self.path = path
         self.problems = problems
-        lines = [f"{path}: {field}: {msg} (value: {value!r})" for field, value, msg in problems]
+        lines = [
+            f"{path}: {field}: {msg}" + ("" if value is NO_VALUE else f" (value: {value!r})")
+            for field, value, msg in problems
+        ]
         super().__init__("\n".join(lines) if lines else f"{path}: invalid cell file")
 
 

@@ -26,6 +26,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from measure.calibration_fields import number_field
 from measure.calibration_uncertainty import CalibrationUncertainty
 from measure.errors import CalibrationError
 
@@ -222,12 +223,7 @@ def _array(
     data: dict[str, Any], key: str, shape: tuple[int, ...] | None, source: str, prefix: str = ""
 ) -> np.ndarray:
     name = prefix + key
-    if key not in data:
-        raise CalibrationError(source, name, "missing")
-    try:
-        arr = np.asarray(data[key], dtype=np.float64)
-    except (TypeError, ValueError):
-        raise CalibrationError(source, name, f"must be numbers, got {data[key]!r}") from None
+    arr = number_field(data, key, source, name)
     if shape is None:
         if arr.ndim != 1 or arr.size not in (4, 5, 8, 12, 14):
             raise CalibrationError(

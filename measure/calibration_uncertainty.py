@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from measure.calibration_fields import number_field
 from measure.errors import CalibrationError
 
 
@@ -107,12 +108,7 @@ class CalibrationUncertainty:
 
 def _std(data: dict[str, Any], key: str, size: int | None, source: str, prefix: str) -> np.ndarray:
     name = prefix + key
-    if key not in data:
-        raise CalibrationError(source, name, "missing")
-    try:
-        arr = np.asarray(data[key], dtype=np.float64)
-    except (TypeError, ValueError):
-        raise CalibrationError(source, name, f"must be numbers, got {data[key]!r}") from None
+    arr = number_field(data, key, source, name)
     if (size is None and arr.ndim != 0) or (size is not None and arr.shape != (size,)):
         want = "one number" if size is None else f"a list of {size} numbers"
         raise CalibrationError(source, name, f"must be {want}, got {data[key]!r}")

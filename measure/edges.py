@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from measure.detect import HoleCandidate, without_bites
+from measure.detect import HoleCandidate
+from measure.outline import without_bites
 from measure.slope import slope_shift
 
 EDGE_METHODS = ("parabola", "linear")

@@ -7,6 +7,8 @@ say which figures decided.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import cv2
 import numpy as np
 
@@ -14,6 +16,25 @@ from measure.errors import ImageError
 
 #: downsampling factor of the search image
 SEARCH_SCALE = 4
+
+
+def read_image(path: str | Path, which: str) -> np.ndarray:
+    """Read an 8- or 16-bit image file as single-channel (colour is converted to gray).
+
+    ``which`` names the image in the :class:`ImageError` raised for a missing or unreadable
+    file (``"left"``, ``"right"``).
+    """
+    if Path(path).is_dir():
+        hint = "(--pairs DIR measures a folder)"
+        raise ImageError(which, f"{path}: is a directory, not an image {hint}")
+    if not Path(path).is_file():
+        raise ImageError(which, f"{path}: no such file")
+    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ImageError(which, f"{path}: not a readable image")
+    if img.ndim == 3:
+        img = cv2.cvtColor(img[:, :, :3], cv2.COLOR_BGR2GRAY)
+    return img
 
 
 def to_gray(img: object, which: str) -> np.ndarray:

@@ -24,7 +24,8 @@ from dataclasses import replace
 import cv2
 import numpy as np
 
-from measure.detect import SEARCH_SCALE, HoleCandidate, _disc_like
+from measure.detect import SEARCH_SCALE, HoleCandidate
+from measure.outline import disc_like
 
 
 def surface_level_search(small: np.ndarray, cx: float, cy: float, d: float) -> float:
@@ -75,7 +76,7 @@ def with_wall_crescent(small: np.ndarray, cand: HoleCandidate) -> HoleCandidate:
     H, W = small.shape
     if x == 0 or y == 0 or x + w == W or y + h == H:
         return out
-    if not _disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), False):
+    if not disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), False):
         return out
     m = cv2.moments(c)
     return replace(

@@ -245,7 +245,9 @@ class GtspLns:
     def run(self, settings: LnsSettings, start: list[int] | None = None) -> LnsResult:
         """Search from ``start`` (a hole order) or the greedy tour; returns the best tour found."""
         if self.k is not None:
-            self.k.compile_kernels()  # before the clock starts
+            from planner.lns_compile import compile_kernels
+
+            compile_kernels()  # before the clock starts
         started = time.thread_time()
         cur = best = self.initial() if start is None else self._local(*self._rechoose(list(start)))
         n = len(self.groups)

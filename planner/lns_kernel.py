@@ -11,7 +11,8 @@ changes is the cost: no temporary matrices and no Python loop over the tour's la
 
 Compiled on first use and cached beside this file (``cache=True``): a fresh process
 loads the machine code instead of compiling again. The move deltas and appliers are
-shared with the neighbour moves of large tours (:mod:`planner.lns_near`).
+shared with the neighbour moves of large tours (:mod:`planner.lns_near`); every kernel of
+both is compiled up front by :func:`planner.lns_compile.compile_kernels`.
 """
 
 from __future__ import annotations
@@ -216,29 +217,3 @@ def insert(
         insert_at(o, v, k, be, h, gnodes[bc])
         k += 1
     return o, v
-
-
-def compile_kernels() -> None:
-    """Compile (or load from the cache) every kernel on a tiny problem, so that a search's
-    work limits and time cap (:mod:`planner.lns`) never count the compiler; fast after
-    the first call in a process."""
-    global _compiled
-    if _compiled:
-        return
-    G = np.ones((4, 4))
-    path = np.array([0, 1, 2, 3, 0], dtype=np.int64)
-    holes = np.array([0, 1, 2], dtype=np.int64)
-    near = np.array([[1, 2], [0, 2], [0, 1]], dtype=np.int64)
-    gnodes, goff = np.array([1, 2, 3], dtype=np.int64), np.array([0, 1, 2, 3], dtype=np.int64)
-    from planner.lns_near import improve_path_near, insert_near  # it imports this module
-
-    improve_path(G, path, 1)
-    improve_path_near(G, path, holes, near, 1)
-    layered(G, holes, gnodes, goff)
-    one, rest = holes[:1], holes[1:]
-    insert(G, one, gnodes[:1], rest, gnodes, goff)
-    insert_near(G, one, gnodes[:1], rest, gnodes, goff, near)
-    _compiled = True
-
-
-_compiled = False

@@ -6,7 +6,7 @@ little that the neighbour moves miss (the standard candidate-list technique of T
 search): the moves here only join a hole to one of its ``K`` nearest holes (``near[h]``,
 hole indices), in O(n K) per move. ``order`` is the hole order of ``path`` (``path[1 + i]``
 is a node of hole ``order[i]``). Compiled and cached like :mod:`planner.lns_kernel`
-(whose :func:`~planner.lns_kernel.compile_kernels` loads these too).
+(:func:`planner.lns_compile.compile_kernels` loads both).
 """
 
 from __future__ import annotations

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 from planner.errors import OptionsError
+
+#: the largest seed: OMPL's generator takes seed + 1 as an unsigned 32-bit number (signed, to
+#: be safe with every binding)
+MAX_SEED = 2**31 - 2
 
 
 @dataclass(frozen=True)
@@ -79,6 +84,8 @@ class Options:
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
                 raise OptionsError(name, value, "must be a positive number")
+        if not isinstance(self.seed, numbers.Integral) or not 0 <= self.seed <= MAX_SEED:
+            raise OptionsError("seed", self.seed, f"must be an integer in [0, {MAX_SEED}]")
         if not 0 < self.roll_step_deg <= 360:
             raise OptionsError("roll_step_deg", self.roll_step_deg, "must lie in (0, 360]")
         if not 0 <= self.tilt_deg < 90:

@@ -8,22 +8,19 @@ Library code reports progress through an optional callback
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
+from planner.cell_identity import cell_sha256, check_tour_for_cell
 from planner.edge_check import BatchEdgeChecker
 from planner.errors import (
     NoReachableHoleError,
     SegmentPlanningError,
     StartConfigurationError,
-    TourCellMismatchError,
     UnreachableHoleError,
 )
 from planner.lazy_edges import PROBE_COARSENESS, REFINE_SHARE, LazyEdgeChecks
@@ -31,13 +28,24 @@ from planner.options import Options
 from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
 from planner.roadmap import Roadmap, build_roadmap, detour_costs
+from planner.route import Route, route_stops
 from planner.segments import Segment, SegmentCache
 from planner.sequence import GtspSequencer, SequenceResult
 from planner.shared import SharedPlan, options_key, unpack
-from planner.timing import JointLimits, TimedMotion
-from planner.tour import LeftOut, Stop, Tour
-from planner.trajectory import Dwell, sample_timeline
+from planner.timing import JointLimits
+from planner.tour import LeftOut, Tour
+from planner.trajectory import sample_timeline
 from planner.viewpoints import HoleCandidates, hole_candidates
+
+__all__ = [
+    "STAGES",
+    "ProgressCallback",
+    "Sequencer",
+    "TourPlanner",
+    "cell_sha256",
+    "check_tour_for_cell",
+    "plan_tour",
+]
 
 log = logging.getLogger(__name__)
 
@@ -58,41 +66,6 @@ ROADMAP_COARSENESS = 6.0
 
 def _no_progress(stage: str, done: int, total: int) -> None:
     log.debug("%s %d/%d", stage, done, total)
-
-
-def cell_sha256(cell: CellLike) -> str:
-    """Identity of a cell: SHA-256 of its file text (or of its name and holes if built in code)."""
-    text = cell.raw_text
-    if not text:
-        holes = [
-            (h.id, h.position_m.round(9).tolist(), h.normal.round(9).tolist())
-            for h in cell.holes_in_cell()
-        ]
-        text = repr((cell.name, cell.robot.model, cell.home_q().round(9).tolist(), holes))
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def check_tour_for_cell(tour: Tour, cell: CellLike) -> None:
-    """Raise :class:`TourCellMismatchError` unless ``tour`` was planned for exactly ``cell``.
-
-    Compares the robot model, the cell name and the SHA-256 of the cell file text.
-    """
-    checks = (
-        ("robot model", tour.robot_model, cell.robot.model),
-        ("cell name", tour.cell_name, cell.name),
-        ("cell sha256", tour.cell_sha256, cell_sha256(cell)),
-    )
-    for field, in_tour, in_cell in checks:
-        if in_tour != in_cell:
-            raise TourCellMismatchError(field, in_tour, in_cell)
-
-
-@dataclass(frozen=True)
-class _Route:
-    hole_ids: list[str]
-    q: NDArray[np.float64]  # (n, dof) stop configurations in order
-    branch: list[int]
-    candidates: list[HoleCandidates]
 
 
 class TourPlanner(LazyEdgeChecks):
@@ -162,9 +135,9 @@ class TourPlanner(LazyEdgeChecks):
             log.warning("hole %s left out: %s", h.hole_id, h.reason)
         return found, left
 
-    def _route(self, cands: list[HoleCandidates], res: SequenceResult) -> _Route:
+    def _route(self, cands: list[HoleCandidates], res: SequenceResult) -> Route:
         pairs = list(zip(res.order, res.choice, strict=True))
-        return _Route(
+        return Route(
             hole_ids=[cands[h].hole_id for h, _ in pairs],
             q=np.array([cands[h].q[c] for h, c in pairs]),
             branch=[int(cands[h].branch[c]) for h, c in pairs],
@@ -174,7 +147,7 @@ class TourPlanner(LazyEdgeChecks):
     def _segments(
         self,
         home: NDArray[np.float64],
-        route: _Route,
+        route: Route,
         cache: SegmentCache,
         seqr: GtspSequencer | None = None,
         nodes: list[int] | None = None,
@@ -224,7 +197,7 @@ class TourPlanner(LazyEdgeChecks):
         limits: JointLimits,
         cache: SegmentCache,
         timings: dict[str, float],
-    ) -> tuple[_Route, list[Segment], SequenceResult, int]:
+    ) -> tuple[Route, list[Segment], SequenceResult, int]:
         """Sequence, avoid colliding edges, plan the segments, feed measured detours back."""
         o = self.options
         home, cands = shared.home, shared.candidates
@@ -293,38 +266,6 @@ class TourPlanner(LazyEdgeChecks):
                 return route, segments, new, rounds
             res = new
 
-    def _stops(
-        self, arm: ArmLike, route: _Route, segments: list[Segment]
-    ) -> tuple[list[Stop], list[TimedMotion | Dwell], float]:
-        o = self.options
-        timeline: list[TimedMotion | Dwell] = []
-        stops: list[Stop] = []
-        clock = 0.0
-        for k, seg in enumerate(segments):
-            timeline.append(seg.motion)
-            clock += seg.motion.duration
-            if k == len(route.hole_ids):
-                break
-            q = route.q[k]
-            T = arm.fk(q, "tcp")
-            pose = {
-                "xyz": [float(v) for v in T[:3, 3]],
-                "quat_xyzw": [float(v) for v in Rotation.from_matrix(T[:3, :3]).as_quat()],
-            }
-            stops.append(
-                Stop(
-                    route.hole_ids[k],
-                    tuple(float(v) for v in q),
-                    clock,
-                    o.dwell_s,
-                    pose,
-                    route.branch[k],
-                )
-            )
-            timeline.append(Dwell(q, o.dwell_s))
-            clock += o.dwell_s
-        return stops, timeline, clock
-
     def prepare(self, cell: CellLike) -> SharedPlan:
         """The seed-independent part of planning ``cell`` (:mod:`planner.shared`): viewpoints,
         the GTSP's nodes and costs, the roadmap."""
@@ -377,7 +318,7 @@ class TourPlanner(LazyEdgeChecks):
         route, segments, seq, rounds = self._sequence_and_paths(shared, limits, cache, timings)
         timings["paths"] = cache.path_time_s
         t = time.perf_counter()
-        stops, timeline, cycle = self._stops(arm, route, segments)
+        stops, timeline, cycle = route_stops(arm, route, segments, o.dwell_s)
         trajectory = sample_timeline(timeline, o.dt)
         self.progress("timing", 1, 1)
         timings["timing"] = cache.timing_time_s + time.perf_counter() - t

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
 
 from planner.errors import TourFileError
 
@@ -110,11 +111,41 @@ class Tour:
 
     def save(self, path: str | Path) -> Path:
         """Write ``tour.json`` (via a temporary file, so an existing file is never half-written)."""
-        target = Path(path)
-        tmp = target.with_name(target.name + ".tmp")
-        tmp.write_text(json.dumps(self.to_dict(), indent=1))
-        tmp.replace(target)
-        return target
+        return write_json(path, self.to_dict())
+
+
+def pose_dict(T: NDArray[np.float64]) -> dict[str, list[float]]:
+    """A 4×4 transform as ``{xyz, quat_xyzw}`` (m)."""
+    T = np.asarray(T, dtype=float)
+    return {
+        "xyz": [float(v) for v in T[:3, 3]],
+        "quat_xyzw": [float(v) for v in Rotation.from_matrix(T[:3, :3]).as_quat()],
+    }
+
+
+def write_json(path: str | Path, data: dict[str, Any]) -> Path:
+    """Write ``data`` as JSON to ``path`` via a temporary name beside it (an existing file is
+    never half-written); returns the path."""
+    target = Path(path)
+    tmp = target.with_name(target.name + ".tmp")
+    tmp.write_text(json.dumps(data, indent=1))
+    tmp.replace(target)
+    return target
+
+
+def read_json_object(path: str | Path) -> dict[str, Any]:
+    """The JSON object in file ``path``; a missing or unreadable file, or one that holds no
+    JSON object, raises :class:`TourFileError` naming the file."""
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text())
+    except FileNotFoundError as exc:
+        raise TourFileError(str(p), "file", "not found") from exc
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise TourFileError(str(p), "file", f"not readable as JSON ({exc})") from exc
+    if not isinstance(data, dict):
+        raise TourFileError(str(p), "file", "expected a JSON object")
+    return data
 
 
 def _require(data: dict[str, Any], key: str, kind: type | tuple[type, ...], where: str) -> Any:
@@ -190,13 +221,4 @@ def tour_from_dict(data: dict[str, Any], where: str = "<tour>") -> Tour:
 
 def load_tour(path: str | Path) -> Tour:
     """Read ``tour.json``; a missing, unreadable or malformed file raises :class:`TourFileError`."""
-    p = Path(path)
-    try:
-        data = json.loads(p.read_text())
-    except FileNotFoundError as exc:
-        raise TourFileError(str(p), "file", "not found") from exc
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise TourFileError(str(p), "file", f"not readable as JSON ({exc})") from exc
-    if not isinstance(data, dict):
-        raise TourFileError(str(p), "file", "expected a JSON object")
-    return tour_from_dict(data, str(p))
+    return tour_from_dict(read_json_object(path), str(Path(path)))

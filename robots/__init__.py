@@ -1,7 +1,8 @@
 """Arm models: URDF, Pinocchio model, OPW kinematics, collision and thermal error model."""
 
 from robots.arm import Arm, LimitScaling, urdf_path
-from robots.dh import DHTable, dh_table, fk_dh
+from robots.dh import DHTable, fk_dh
+from robots.dh_models import dh_table
 from robots.errors import (
     DHFormError,
     JointVectorError,

@@ -11,7 +11,8 @@ with ``theta_i = q_i + theta_offset_i``. Frame 0 is ``base_link``; frame 6 is
 
 The thermal model (:mod:`robots.thermal`) scales ``a`` and ``d`` and adds
 offsets to ``theta``; so forward kinematics takes the table as an argument.
-Tables are derived from the URDF (:mod:`robots.dh_derive`), never kept by hand.
+Tables are derived from the URDF (:mod:`robots.dh_derive`), never kept by hand; the
+built-in models' tables are :func:`robots.dh_models.dh_table`.
 """
 
 from __future__ import annotations
@@ -21,8 +22,6 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-
-from robots.models import MODELS, ArmSpec
 
 Array = NDArray[np.float64]
 
@@ -63,28 +62,6 @@ class DHTable:
     def with_offsets(self, theta_offset_rad: ArrayLike) -> DHTable:
         """A copy with other joint offsets (rad)."""
         return replace(self, theta_offset_rad=tuple(map(float, theta_offset_rad)))
-
-
-def dh_table(spec: ArmSpec | str) -> DHTable:
-    """The D-H table of a built-in model (by spec or name), derived from its URDF.
-
-    Same derivation as for any URDF (:mod:`robots.dh_derive` from the OPW parameters of
-    :mod:`robots.opw`), so the table cannot disagree with the URDF.
-    """
-    return _builtin_table(spec if isinstance(spec, str) else spec.name)
-
-
-@lru_cache(maxsize=8)
-def _builtin_table(name: str) -> DHTable:
-    from robots.arm_kinematics import derive_kinematics
-    from robots.urdf_load import load_urdf
-    from robots.urdf_writer import URDF_DIR
-
-    if name not in MODELS:
-        raise KeyError(name)
-    table = derive_kinematics(load_urdf(URDF_DIR / f"{name}.urdf")).dh
-    assert table is not None  # the built-in chains have the ABB layout
-    return table
 
 
 @lru_cache(maxsize=64)

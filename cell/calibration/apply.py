@@ -39,6 +39,7 @@ class CalibratedKinematics:
         self.delta = cal.delta
         self.dh_table: DHTable = calibrated_table(base, self.delta)
         self.T_tool0_camera: Array = cal.T_tool0_camera.T.copy()
+        self._factor: Array | None = None
 
     def T_base_tool0(self, q: ArrayLike) -> Array:
         """``T_base_tool0`` (..., 4, 4) of joints ``q`` (rad, (6,) or (N, 6)), calibrated."""
@@ -50,7 +51,8 @@ class CalibratedKinematics:
 
     def point_covariance(self, q: ArrayLike, p_camera_m: ArrayLike, frame: str = "base") -> Array:
         """Covariance (3, 3) (m^2) of the point ``p_camera_m`` (3,) fixed in the left camera's
-        frame, at joints ``q`` (6,): ``J C J^T`` over the free hand-eye and D-H terms.
+        frame, at joints ``q`` (6,): ``J C J^T`` over the free hand-eye and D-H terms
+        (``J``: :meth:`point_jacobian`).
 
         ``frame="base"``: in ``base_link`` (the target's pose and the stereo extrinsics do not
         move such a point; but ``base_link`` itself is only known through the target, so this
@@ -58,6 +60,14 @@ class CalibratedKinematics:
         target's pose absorbs). ``frame="target"``: relative to the calibration target, with
         the target's pose and its correlations included: the uncertainty of a point measured
         in a cell whose frame is tied to the target."""
+        J = self.point_jacobian(q, p_camera_m, frame)
+        return J @ self.calibration.covariance @ J.T
+
+    def point_jacobian(self, q: ArrayLike, p_camera_m: ArrayLike, frame: str = "base") -> Array:
+        """``J`` (3, p): the point's motion (m, in ``base_link`` axes, or the target's for
+        ``frame="target"``) per unit change of each free parameter (``parameter_names``
+        order; zero columns for the stereo extrinsics, which do not move a point of the left
+        camera, and for the target's pose with ``frame="base"``)."""
         if frame not in ("base", "target"):
             raise ValueError(f"frame must be 'base' or 'target', got {frame!r}")
         cal = self.calibration
@@ -89,4 +99,14 @@ class CalibratedKinematics:
         for i, name in enumerate(cal.parameter_names):
             if name in cols:
                 J[:, i] = cols[name]
-        return J @ cal.covariance @ J.T
+        return J
+
+    def covariance_factor(self) -> Array:
+        """``L`` (p, p) with ``L L^T`` = the parameters' covariance (a symmetric square root;
+        negative rounding eigenvalues clipped): ``J L z`` with ``z ~ N(0, I)`` draws a point's
+        error, one ``z`` shared by every point of a run."""
+        if self._factor is None:
+            C = self.calibration.covariance
+            w, v = np.linalg.eigh(0.5 * (C + C.T))
+            self._factor = v * np.sqrt(np.clip(w, 0.0, None))
+        return self._factor

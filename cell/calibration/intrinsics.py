@@ -7,6 +7,7 @@ OpenCV order), as OpenCV's calibration sample writes them; ``image_width`` and
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import cv2
@@ -16,20 +17,47 @@ from cell.calibration.errors import CalibrationDataError
 from cell.calibration.observations import Intrinsics
 
 
+def _why(exc: BaseException) -> str:
+    """``: the parser's words`` of an OpenCV FileStorage error (empty when it has none)."""
+    text = str(exc.__cause__ or exc)
+    m = re.search(r"in function '[^']*?: ([^']+)'", text)
+    return f": {m.group(1)}" if m else " (empty or unreadable)"
+
+
+def _matrix(fs: cv2.FileStorage, name: str, src: str) -> np.ndarray | None:
+    """The matrix node ``name`` (None when absent); a node of another kind is refused."""
+    node = fs.getNode(name)
+    if node.empty() or node.isNone():
+        return None
+    if node.isSeq():  # a plain list of numbers
+        try:
+            return np.array([node.at(i).real() for i in range(node.size())], float)
+        except cv2.error:
+            raise CalibrationDataError(src, f"{name}: not a list of numbers") from None
+    try:
+        return node.mat()
+    except cv2.error:
+        raise CalibrationDataError(src, f"{name}: not an OpenCV matrix (!!opencv-matrix)") from None
+
+
 def read_intrinsics(path: str | Path, image_size: tuple[int, int] | None = None) -> Intrinsics:
     """Read ``camera_matrix`` and ``distortion_coefficients``; refuse naming the node."""
     src = str(path)
+    if Path(path).is_dir():
+        raise CalibrationDataError(src, "is a directory, not an intrinsics file")
     if not Path(path).is_file():
         raise CalibrationDataError(src, "no such file")
     try:
         fs = cv2.FileStorage(src, cv2.FILE_STORAGE_READ)
-    except cv2.error as exc:
-        raise CalibrationDataError(src, f"not an OpenCV FileStorage file: {exc.err}") from None
+    except (cv2.error, SystemError) as exc:  # an empty file: SystemError around cv2.error
+        raise CalibrationDataError(src, f"not an OpenCV FileStorage file{_why(exc)}") from None
     if not fs.isOpened():
         raise CalibrationDataError(src, "not an OpenCV FileStorage file")
     try:
-        K = fs.getNode("camera_matrix").mat()
-        dist = fs.getNode("distortion_coefficients").mat()
+        if not fs.root().isMap():
+            raise CalibrationDataError(src, "not a mapping of named nodes (camera_matrix, ...)")
+        K = _matrix(fs, "camera_matrix", src)
+        dist = _matrix(fs, "distortion_coefficients", src)
         w = fs.getNode("image_width")
         h = fs.getNode("image_height")
         size = (int(w.real()), int(h.real())) if not w.empty() and not h.empty() else image_size

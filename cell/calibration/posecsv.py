@@ -9,7 +9,8 @@ Columns (header row, names exact, others ignored):
   ``qx, qy, qz, qw`` (unit quaternion of ``R_base_tool0``).
 
 Refused with the file and row named (row = data row, 1-based; the header is not counted):
-missing columns, a row without an image, a value that is not a finite number, joints that look
+missing columns (with a hint when one is there in other units: ``q1_deg``, ``x_mm``), a row
+without an image, a value that is not a finite number, joints that look
 like degrees (any beyond 2 pi), translations that look like millimetres (any beyond 5 m),
 quaternions that are not of unit length.
 """
@@ -51,6 +52,22 @@ class PoseRow:
     T_base_tool0: Array | None
 
 
+def _names(cols: list[str]) -> str:
+    return ", ".join(cols) if len(cols) <= 3 else f"{cols[0]}..{cols[-1]}"
+
+
+def _unit_hint(missing: list[str], header: list[str]) -> str:
+    """``: found q1_deg..q6_deg, ...`` when missing columns are in the header in other units."""
+    stems = {c.rsplit("_", 1)[0] for c in missing if "_" in c}
+    other = [h for h in header if "_" in h and h.rsplit("_", 1)[0] in stems and h not in missing]
+    if not other:
+        return ""
+    return (
+        f": found {_names(other)}, the file is in radians and metres "
+        "(q1_rad, x_m): convert the values and rename the columns"
+    )
+
+
 def _number(text: str | None, src: str, row: int, column: str) -> float:
     try:
         v = float(text) if text is not None else math.nan
@@ -84,7 +101,9 @@ def read_pose_csv(path: str | Path, use_joints: bool) -> tuple[PoseRow, ...]:
     pose_cols = JOINT_COLUMNS if use_joints else FLANGE_COLUMNS
     missing = [c for c in (*image_cols, *pose_cols) if c not in header]
     if missing:
-        hint = ""
+        hint = _unit_hint(missing, header)
+        if hint:
+            raise CalibrationDataError(src, f"missing column(s) {_names(missing)}{hint}")
         if use_joints and all(c in header for c in FLANGE_COLUMNS):
             hint = " (the file gives flange poses: leave out --cell)"
         elif not use_joints and all(c in header for c in JOINT_COLUMNS):

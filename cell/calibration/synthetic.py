@@ -213,7 +213,7 @@ def example_truth(
     (0.25 m), the standard toed-in head (:func:`measure.synth.heads.standard_stereo`) 0.1 m
     below the flange, looking along ``tool0`` z."""
     from measure.synth.heads import standard_stereo
-    from robots.dh import dh_table
+    from robots.dh_models import dh_table
 
     cams = cameras or Cameras.from_stereo(standard_stereo())
     if not stereo:

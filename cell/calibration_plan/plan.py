@@ -29,6 +29,7 @@ from cell.calibration_plan.design import (
     predict_sigmas,
 )
 from cell.calibration_plan.head_model import stereo_model
+from cell.calibration_plan.orientations import orientation_figures
 from cell.calibration_plan.target import TargetGeometry, board_of
 from cell.config import CellConfig
 from cell.errors import CellError
@@ -138,6 +139,7 @@ def plan_calibration(
     ids = view_ids(len(rows))
     tour = plan_view_tour(cell, chosen, ids, o.tour, progress)
     score = geometry_score(cands, list(rows), head.image_size, box, o.preselect)
+    orientations, min_between = orientation_figures(cands.T_cell_tcp[list(rows), :3, :3])
     design = {
         "criterion": o.criterion,
         "candidates": len(cands),
@@ -146,6 +148,8 @@ def plan_calibration(
         "image_share": score.image,
         "joint_share": score.joints,
         "min_rotation_rad": score.min_rotation_rad,
+        "orientations": orientations,
+        "min_rotation_between_orientations_rad": min_between,
         "axis_eigen_min": score.axis_eigen_min,
         "joint_range_rad": [box[0].tolist(), box[1].tolist()],
         "timings_s": timings,

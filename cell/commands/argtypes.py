@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 
 
 def non_negative_int(text: str) -> int:
@@ -77,4 +78,27 @@ def positive_int(text: str) -> int:
     value = non_negative_int(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"{value} is not positive (give 1 or more)")
+    return value
+
+
+def output_file(text: str) -> Path:
+    """A file to write: not a directory, in a folder that exists (checked before any work, so
+    a mistake costs nothing and leaves nothing half-written)."""
+    path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a directory; give a file name")
+    if not path.parent.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: folder {path.parent} does not exist")
+    return path
+
+
+def hole_diameter_m(text: str) -> float:
+    """A hole diameter (m): positive, and not so large that it must be millimetres."""
+    from cell.gdt.plausible import MAX_DIAMETER_M
+
+    value = positive_float(text)
+    if value > MAX_DIAMETER_M:
+        raise argparse.ArgumentTypeError(
+            f"{value:g} m: metres expected, this looks like millimetres ({value / 1e3:g} m?)"
+        )
     return value

@@ -4,8 +4,9 @@
 ``calibrate hand-eye`` (:mod:`cell.commands.calibrate_handeye_cmd`) the head on the flange,
 the target in the base, the arm's D-H errors and the stereo extrinsics from recorded data;
 ``calibrate cell`` (:mod:`cell.commands.calibrate_cell_cmd`) the same by running the calibration
-tour in the cell. The older form ``holecell calibrate --left ... --right ...`` is the stereo
-calibration.
+tour in the cell; ``calibrate example`` (:mod:`cell.commands.calibrate_example_cmd`) writes a
+synthetic set of such data to try it on. The older form ``holecell calibrate --left ... --right
+...`` is the stereo calibration.
 A new calibration is one more module in :data:`CALIBRATE_MODULES` with a ``register(sub)``.
 """
 
@@ -22,6 +23,7 @@ CALIBRATE_MODULES: tuple[str, ...] = (
     "calibrate_stereo_cmd",
     "calibrate_handeye_cmd",
     "calibrate_cell_cmd",
+    "calibrate_example_cmd",
 )
 
 
@@ -33,13 +35,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``calibrate`` subcommand and its own subcommands."""
     p = sub.add_parser(
         "calibrate",
-        help="calibrations: stereo head (stereo), hand-eye and kinematics (hand-eye, cell)",
+        help="calibrations: stereo head (stereo), hand-eye and kinematics (hand-eye, cell), "
+        "a set to try them (example)",
         description=(
             "Calibrations from images of a plate target. 'calibrate stereo' calibrates the "
             "stereo head; 'calibrate hand-eye' the head on the flange, the target in the base, "
             "the arm's D-H errors and the stereo extrinsics from images and robot poses "
             "recorded elsewhere; 'calibrate cell' the same by running the calibration tour on "
-            "the controller and the head. Without a subcommand, --left/--right run the stereo "
+            "the controller and the head; 'calibrate example DIR' writes a synthetic set to try "
+            "it on. Without a subcommand, --left/--right run the stereo "
             "calibration (the older form): " + calibrate_stereo_cmd.DESCRIPTION
         ),
     )
@@ -59,7 +63,7 @@ def _older_form(args: argparse.Namespace) -> int:
     ]
     if missing:
         raise CalibrateUsageError(
-            "give a subcommand (stereo, hand-eye, cell) or the stereo calibration's options; "
-            "missing: " + ", ".join(missing)
+            "give a subcommand (stereo, hand-eye, cell, example) or the stereo calibration's "
+            "options; missing: " + ", ".join(missing)
         )
     return calibrate_stereo_cmd.run(args)

@@ -6,6 +6,7 @@ import argparse
 
 import numpy as np
 
+from cell.commands.argtypes import output_file
 from cell.commands.calibrate_stereo_cmd import add_board_arguments
 
 DESCRIPTION = (
@@ -42,7 +43,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--cell", metavar="CELL", help="cell file: the arm's kinematics (joints rows)")
     add_board_arguments(p)
-    p.add_argument("-o", "--output", default="cellcal.json", help="file to write (cellcal.json)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        default="cellcal.json",
+        help="file to write (cellcal.json)",
+    )
     p.add_argument(
         "--no-kinematics", action="store_true", help="do not estimate the D-H errors (joints rows)"
     )

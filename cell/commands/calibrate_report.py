@@ -21,6 +21,14 @@ def _pose_line(name: str, p: PoseEstimate) -> str:
     return f"{name}: xyz [{pos}] mm, rpy [{rot}] deg (rotation sigma [{srot}] deg)"
 
 
+def dh_term_text(name: str, value: float, sigma: float) -> str:
+    """A D-H error in display units: ``a1 +0.8900 ± 0.0100 mm`` for ``a1_m`` (m), ``theta2
+    -0.0123 ± 0.0010 deg`` for ``theta2_rad`` (rad); the unit follows the value it labels."""
+    stem, unit = name.rsplit("_", 1)
+    scale, shown = (1e3, "mm") if unit == "m" else (float(np.rad2deg(1.0)), "deg")
+    return f"{stem} {value * scale:+.4f} ± {sigma * scale:.4f} {shown}"
+
+
 def print_result(result: CalibrationResult) -> None:
     """Print the estimates with their sigmas, the fixed terms, residuals and OpenCV's answers."""
     cal = result.calibration
@@ -50,12 +58,7 @@ def print_result(result: CalibrationResult) -> None:
         print(_pose_line("T_left_right", cal.T_left_right))
     free = [t for t in cal.dh_terms if t.free]
     if free:
-        terms = ", ".join(
-            f"{t.name} {t.value * (1e3 if t.name.endswith('_m') else np.rad2deg(1)):+.4f}"
-            f"±{t.sigma * (1e3 if t.name.endswith('_m') else np.rad2deg(1)):.4f}"
-            for t in free
-        )
-        print(f"D-H errors (mm, deg): {terms}")
+        print(f"D-H errors: {', '.join(dh_term_text(t.name, t.value, t.sigma) for t in free)}")
     if result.intrinsics:
         shown = ", ".join(f"{n.removeprefix('intrinsics.')} {v:+.2f}±{e:.2f}"
                           for n, (v, e) in result.intrinsics.items())  # fmt: skip

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cell.commands.argtypes import output_file
 from cell.commands.measure_cmd import read_image
 from measure.errors import CalibrationTargetError
 from measure.stereo_calibrate import CalibrateOptions, calibrate_stereo
@@ -52,7 +53,13 @@ def add_arguments(p: argparse.ArgumentParser, required: bool) -> None:
     p.add_argument("--left", nargs="+", required=required, help="left images (files or a glob)")
     p.add_argument("--right", nargs="+", required=required, help="right images (files or a glob)")
     add_board_arguments(p, required)
-    p.add_argument("-o", "--output", default="stereo.json", help="file to write (stereo.json)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        default="stereo.json",
+        help="file to write (stereo.json)",
+    )
     p.add_argument(
         "--drop-outliers",
         action="store_true",
@@ -85,7 +92,10 @@ def add_board_arguments(p: argparse.ArgumentParser, required: bool = True) -> No
 def run(args: argparse.Namespace) -> int:
     """Handler: detect, calibrate, report, write."""
     lefts, rights = _expand(args.left), _expand(args.right)
-    if not lefts or len(lefts) != len(rights):
+    for flag, given, found in (("--left", args.left, lefts), ("--right", args.right, rights)):
+        if not found:
+            raise CalibrationTargetError(f"{flag} {' '.join(given)}: no image matches", [])
+    if len(lefts) != len(rights):
         raise CalibrationTargetError(
             f"need the same number of left and right images, got {len(lefts)} and {len(rights)}", []
         )

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from cell.commands.group_help import help_handler
 from cell.config import CellConfig, load_cell
 from cell.errors import CellError
 from cell.reach import hole_reach
@@ -31,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     show.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
     show.add_argument("--roll-step-deg", type=float, default=15.0, help="roll sampling (deg)")
     show.set_defaults(handler=run_show)
-    cell.set_defaults(handler=lambda args: (cell.print_help(), 2)[1])
+    cell.set_defaults(handler=help_handler(cell))
 
 
 def _count(n: int, noun: str) -> str:

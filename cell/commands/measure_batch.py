@@ -35,6 +35,7 @@ from typing import Any
 from cell.commands.run_progress import bar
 from cell.errors import CellError
 from measure import MeasureOptions, StereoCalibration, measure_hole
+from measure.image_input import read_image
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm")
 _SIDE = re.compile(
@@ -166,8 +167,6 @@ def _row(entry: PairEntry) -> dict[str, Any]:
 
 def measure_pairs(entries, stereo, diameter_m, opts, progress=None) -> list[dict[str, Any]]:
     """Measure each entry; a failure is the row's ``status: error`` with its reason."""
-    from cell.commands.measure_cmd import read_image
-
     rows = []
     for k, entry in enumerate(entries):
         row = _row(entry)

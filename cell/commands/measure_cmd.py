@@ -4,25 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-import cv2
 import numpy as np
 
+from cell.commands.argtypes import hole_diameter_m, output_file
 from measure import MeasureOptions, StereoCalibration, measure_hole
 from measure.errors import ImageError, MeasurementError
+from measure.image_input import read_image
 
-
-def read_image(path: str, which: str) -> np.ndarray:
-    """Read an 8- or 16-bit image as single-channel (colour is converted to gray)."""
-    if not Path(path).is_file():
-        raise ImageError(which, f"{path}: no such file")
-    img = cv2.imread(path, cv2.IMREAD_UNCHANGED)
-    if img is None:
-        raise ImageError(which, f"{path}: not a readable image")
-    if img.ndim == 3:
-        img = cv2.cvtColor(img[:, :, :3], cv2.COLOR_BGR2GRAY)
-    return img
+__all__ = ["read_image", "register", "run"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -45,9 +35,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("left", nargs="?", help="left camera image")
     p.add_argument("right", nargs="?", help="right camera image")
     p.add_argument("--pairs", metavar="DIR|LIST", help="measure every pair of a folder or list")
-    p.add_argument("-o", "--output", help="with --pairs: write the rows to FILE (.csv or .json)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        help="with --pairs: write the rows to FILE (.csv or .json)",
+    )
     p.add_argument("--stereo", required=True, help="stereo calibration file (stereo.json)")
-    p.add_argument("--diameter", type=float, default=None, help="expected diameter (metres)")
+    p.add_argument(
+        "--diameter", type=hole_diameter_m, default=None, help="expected diameter (metres)"
+    )
     p.add_argument(
         "--method",
         choices=("default", "published"),

@@ -84,14 +84,26 @@ def summary(cal: CalibrationTour, path: Path) -> list[str]:
         f"robot time    {tour.cycle_time_s:.1f} s  (dwell {tour.settings.get('dwell_s', 0.0)} s "
         "per view)",
         f"planning time {tour.planning_time_s:.1f} s",
-        f"geometry      rotation share {d['rotation_share']:.2f}, smallest rotation between "
-        f"views {np.degrees(d['min_rotation_rad']):.1f} deg, axis eigenvalue "
+        f"geometry      rotation share {d['rotation_share']:.2f}, axis eigenvalue "
         f"{d['axis_eigen_min']:.2f}; image share {d['image_share']:.2f}; joint share "
         f"{d['joint_share']:.2f}",
+        orientation_line(d, len(tour.stops)),
     ]
     lines += prediction_lines(cal.prediction)
     lines.append(f"written       {path}")
     return lines
+
+
+def orientation_line(design: dict, views: int) -> str:
+    """How many orientations the views hold and the smallest rotation between two of them
+    (views from one direction at other distances or offsets share one: ``min_rotation_rad``,
+    between any two views, is then 0 and says nothing about the hand-eye)."""
+    k, gap = design["orientations"], design["min_rotation_between_orientations_rad"]
+    shared = (
+        "" if k == views else f" (the other {views - k} repeat one from another distance or offset)"
+    )
+    between = "" if gap is None else f", at least {np.degrees(gap):.1f} deg apart"
+    return f"orientations  {k} distinct{between}{shared}"
 
 
 def prediction_lines(p: dict) -> list[str]:

@@ -20,6 +20,14 @@ from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.review.recording import Recorder
 from cell.review.report import format_summary, write_report
+from cell.run.calibration import (
+    MAX_AGE_DAYS,
+    RunCalibration,
+    RunGeometry,
+    load_run_calibration,
+    store_calibration,
+    stored_calibration_path,
+)
 from cell.run.camera import NetworkCamera, cell_stereo
 from cell.run.reference import plan_reference_tour
 from cell.run.runner import Runner, RunOptions
@@ -58,6 +66,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default=None, help="run directory to create (default: runs/<tour>)")
     p.add_argument("--resume", metavar="RUN_DIR", help="continue the run stored in RUN_DIR")
     p.add_argument("--thermal", help="thermal.json model to start from (holecell thermal)")
+    p.add_argument("--calibration", metavar="CELLCAL.json",
+                   help="the cell calibration (holecell calibrate cell): holes are carried "
+                        "through its D-H table and hand-eye, each stop's joints are corrected "
+                        "for it, the thermal model identifies on top of it and its covariance "
+                        "joins every hole's budget. Refused if made for another robot, tool, "
+                        "cell or stereo calibration, or older than --calibration-max-age. "
+                        "Copied into the run directory; --resume uses that copy")  # fmt: skip
+    p.add_argument(
+        "--calibration-max-age",
+        type=non_negative_float,
+        default=MAX_AGE_DAYS,
+        metavar="DAYS",
+        help=f"refuse a calibration older than this (default {MAX_AGE_DAYS:g} days)",
+    )
     p.add_argument("--reference-rounds", type=non_negative_int, default=2,
                    help="rounds over the reference targets before the holes, "
                         "--reference-interval-s apart (default 2: a model is identified only "
@@ -101,29 +123,54 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=run_run)
 
 
-def _thermal_model(path: str | None, cell: CellConfig) -> ThermalModel | None:
-    """The ``--thermal`` model, refused unless it was identified for this cell's arm, D-H table,
-    base pose and tool (the sensor count is checked against the controller once connected)."""
+def _thermal_model(
+    path: str | None, cell: CellConfig, calibration: RunCalibration | None
+) -> ThermalModel | None:
+    """The ``--thermal`` model, refused unless it was identified for this cell's arm, D-H table
+    (the calibrated one with ``--calibration``), base pose and tool (the sensor count is
+    checked against the controller once connected)."""
     if not path:
         return None
     model = load_model(path)
-    check_model_for_cell(model, cell.build_arm(), cell.robot.model, path)
+    arm = cell.build_arm()
+    check_model_for_cell(model, RunGeometry(arm, cell_stereo(cell), calibration),
+                         cell.robot.model, path)  # fmt: skip
     return model
+
+
+def _calibration(
+    args: argparse.Namespace, cell: CellConfig, run_dir: Path | None
+) -> RunCalibration | None:
+    """``--calibration`` checked for ``cell`` (robot, tool, cell, stereo, age), or the copy a
+    resumed run (``run_dir``) stored, checked against its stored cell (not its age)."""
+    if run_dir is not None:
+        if args.calibration:
+            raise CellError("--resume uses the calibration stored with the run; do not give "
+                            "--calibration")  # fmt: skip
+        stored = stored_calibration_path(run_dir)
+        if stored is None:
+            return None
+        return load_run_calibration(stored, cell, cell.build_robot(), cell_stereo(cell), None)
+    if not args.calibration:
+        return None
+    return load_run_calibration(args.calibration, cell, cell.build_robot(), cell_stereo(cell),
+                                args.calibration_max_age)  # fmt: skip
 
 
 def _prepare(
     args: argparse.Namespace,
-) -> tuple[CellConfig, ThermalModel | None, Callable[[], RunFiles]]:
-    """The cell, the checked thermal model, and how to open the run's store once controller and
-    head answer. Every input is checked here, before anything is planned, connected or
-    written."""
+) -> tuple[CellConfig, ThermalModel | None, RunCalibration | None, Callable[[], RunFiles]]:
+    """The cell, the checked thermal model and calibration, and how to open the run's store
+    once controller and head answer. Every input is checked here, before anything is planned,
+    connected or written."""
     if args.resume:
         if args.tour or args.cell:
             raise CellError("--resume takes the cell and tour from the run; give neither")
         files = resume_run(args.resume)  # checked now, reopened once the cell answers
         files.store.close()
-        model = _thermal_model(args.thermal, files.cell)
-        return files.cell, model, lambda: resume_run(args.resume)
+        cal = _calibration(args, files.cell, Path(args.resume))
+        model = _thermal_model(args.thermal, files.cell, cal)
+        return files.cell, model, cal, lambda: resume_run(args.resume)
     if not args.tour or not args.cell:
         raise CellError("give TOUR and --cell CELL (or --resume RUN_DIR)")
     out = Path(args.out) if args.out else Path("runs") / Path(args.tour).stem
@@ -131,13 +178,14 @@ def _prepare(
     cell = load_cell(args.cell)
     tour = load_tour(args.tour)
     check_tour(tour, cell, args.tour)
-    model = _thermal_model(args.thermal, cell)
+    cal = _calibration(args, cell, None)
+    model = _thermal_model(args.thermal, cell, cal)
     reference = (
         plan_reference_tour(cell, tour=tour)
         if cell.reference_targets and args.reference_rounds
         else None
     )
-    return cell, model, lambda: start_run(out, cell, tour, args.tour, args.port, reference)
+    return cell, model, cal, lambda: start_run(out, cell, tour, args.tour, args.port, reference)
 
 
 def _rrd_path(run_dir: Path) -> Path:
@@ -182,7 +230,7 @@ def _ask_start() -> None:
 
 def run_run(args: argparse.Namespace) -> int:
     """Handler of ``holecell run``."""
-    cell, model, open_files = _prepare(args)
+    cell, model, calibration, open_files = _prepare(args)
     client = ControllerClient(args.port)
     camera = recorder = files = None
     try:
@@ -198,6 +246,8 @@ def run_run(args: argparse.Namespace) -> int:
         camera = NetworkCamera(args.camera, cell_stereo(cell))
         files = open_files()
         run_dir = files.store.path.parent
+        if calibration is not None:
+            store_calibration(calibration, run_dir)
         stored = len(files.store.done_ids())
         options = RunOptions(
             settle_s=args.settle_s,
@@ -212,7 +262,7 @@ def run_run(args: argparse.Namespace) -> int:
             recorder = Recorder.create(_rrd_path(run_dir), files.cell, files.tour, args.spawn,
                                        args.connect)  # fmt: skip
         runner = Runner(files.cell, files.tour, files.store, client, camera, options,
-                        files.reference, model, progress, recorder)  # fmt: skip
+                        files.reference, model, progress, recorder, calibration)  # fmt: skip
         try:
             result = runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
         except BaseException:

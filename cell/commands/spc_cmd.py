@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from cell.review.spc.collect import read_runs, series
-from cell.review.spc.write import analyse, write_spc
+from cell.review.spc.collect import SpcError, read_runs, series
+from cell.review.spc.write import Analysis, analyse, write_spc
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,24 +32,47 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=run_spc)
 
 
+#: characteristics named in the summary line of those without statistics (then "...")
+MAX_NAMED = 4
+
+
+def _names(results: list[Analysis]) -> str:
+    names = [a.series.name for a in results]
+    more = ", ..." if len(names) > MAX_NAMED else ""
+    return ", ".join(names[:MAX_NAMED]) + more
+
+
 def run_spc(args: argparse.Namespace) -> int:
-    """Handler of ``holecell spc``."""
+    """Handler of ``holecell spc``: exit 0 when at least one characteristic has statistics;
+    exit 2 (a refusal, nothing written) when none has: no characteristics in the runs, or
+    none evaluated in two runs (a single run given)."""
     runs = read_runs(args.run_dirs)
     results = analyse(series(runs))
+    where = str(Path(runs[0].path).parent) if len(runs) == 1 else f"{len(runs)} runs"
+    if not results:
+        raise SpcError(
+            f"{where}: the report.qif carry no characteristics (no drawing tolerances "
+            "evaluated): nothing to chart"
+        )
+    done = [a for a in results if a.cap is not None]
+    undone = [a for a in results if a.cap is None]
+    if not done:
+        raise SpcError(
+            f"{where}: statistics need a characteristic evaluated in two runs or more; none "
+            f"of the {len(results)} is (give more run directories, or a folder of runs)"
+        )
     out = args.out or (args.run_dirs[0] if len(args.run_dirs) == 1 else ".")
     csv_path, html_path = write_spc(results, [str(Path(r.path).parent) for r in runs], out)
-    print(f"{len(runs)} runs, {len(results)} characteristics")
-    if not results:
-        print("  (the runs' report.qif carry no characteristics: no drawing tolerances evaluated)")
-    for a in results:
+    why = f" (evaluated in fewer than two runs: {_names(undone)})" if undone else ""
+    print(
+        f"{len(runs)} runs, {len(results)} characteristics: statistics for {len(done)}, "
+        f"not for {len(undone)}{why}"
+    )
+    for a in done:
         s, cap = a.series, a.cap
-        if cap is None:
-            print(f"  {s.name:<22} {a.why}")
-        else:
-            cpk = "-" if cap.cpk is None else f"{cap.cpk:.2f}"
-            print(
-                f"  {s.name:<22} n {cap.n:3d}  Cpk {cpk:>6}  out of control "
-                f"{len(cap.out_of_control)}"
-            )
+        cpk = "-" if cap.cpk is None else f"{cap.cpk:.2f}"
+        print(
+            f"  {s.name:<22} n {cap.n:3d}  Cpk {cpk:>6}  out of control {len(cap.out_of_control)}"
+        )
     print(f"wrote {csv_path} and {html_path}")
     return 0

@@ -20,7 +20,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robots.dh import DHTable, dh_table
+from cell.commands.argtypes import output_file
+from cell.commands.group_help import help_handler
+from robots.dh import DHTable
+from robots.dh_models import dh_table
 from robots.models import MODELS
 from robots.thermal import (
     CellGeometry,
@@ -61,7 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Temperature error compensation on the D-H model of the arm.",
     )
     sub = p.add_subparsers(dest="thermal_command", metavar="STEP")
-    p.set_defaults(handler=lambda args: _help(p))
+    p.set_defaults(handler=help_handler(p))
     ident = sub.add_parser(
         "identify",
         help="fit the thermal model to reference-target observations",
@@ -72,7 +75,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     ident.add_argument("observations", type=Path, metavar="OBS.csv")
     ident.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
-    ident.add_argument("-o", "--output", type=Path, required=True, metavar="thermal.json")
+    ident.add_argument("-o", "--output", type=output_file, required=True, metavar="thermal.json")
     ident.add_argument(
         "--sensor-map",
         metavar="S1,..,S6",
@@ -96,7 +99,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     pred.add_argument("model", type=Path, metavar="thermal.json")
     pred.add_argument("poses", type=Path, metavar="POSES.csv")
-    pred.add_argument("-o", "--output", type=Path, help="output CSV (default: standard output)")
+    pred.add_argument(
+        "-o", "--output", type=output_file, help="output CSV (default: standard output)"
+    )
     pred.add_argument(
         "--command",
         dest="joint_command",
@@ -113,7 +118,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "+15 K in two hours) and writes the observations CSV that 'thermal identify' reads.",
     )
     sim.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
-    sim.add_argument("-o", "--output", type=Path, required=True, metavar="OBS.csv")
+    sim.add_argument("-o", "--output", type=output_file, required=True, metavar="OBS.csv")
     sim.add_argument("--hours", type=float, default=2.0, help="warm-up duration (default 2)")
     sim.add_argument("--every-s", type=float, default=300.0, help="period (s, default 300)")
     sim.add_argument("--noise-um", type=float, default=5.0, help="noise per axis (um, default 5)")
@@ -129,11 +134,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     from cell.commands import thermal_plan_cmd
 
     thermal_plan_cmd.register(sub)
-
-
-def _help(parser: argparse.ArgumentParser) -> int:
-    parser.print_help()
-    return 2
 
 
 def _table_of(cfg: CellConfig) -> DHTable:
@@ -265,18 +265,12 @@ def run_predict(args: argparse.Namespace) -> int:
 def run_simulate(args: argparse.Namespace) -> int:
     """Simulated warm-up observations of the cell's reference targets."""
     from cell.config import load_cell
-    from cell.errors import ConfigError
+    from cell.errors import CellError
 
     if not (0 < args.hours < 1e3 and 0 < args.every_s < 1e6 and 0 <= args.noise_um < 1e6):
-        raise ConfigError(
-            "holecell thermal simulate",
-            [
-                (
-                    "--hours/--every-s/--noise-um",
-                    (args.hours, args.every_s, args.noise_um),
-                    "need a positive duration and period and a non-negative noise",
-                )
-            ],
+        raise CellError(
+            f"--hours {args.hours:g}, --every-s {args.every_s:g}, --noise-um {args.noise_um:g}: "
+            "need a positive duration and period and a non-negative noise"
         )
     cfg = load_cell(args.cell)
     geometry, _, table = _geometry(cfg, args.cell)

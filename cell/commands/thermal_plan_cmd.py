@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.commands.argtypes import non_negative_int, positive_float
+from cell.commands.argtypes import non_negative_int, output_file, positive_float
 from cell.config import CellConfig, ReferenceTarget, load_cell
 from cell.errors import CellError
 from cell.run.reference import design_reference_plan, fixed_reference_plan, hole_stops
@@ -49,7 +49,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--cell", required=True, help="cell file (YAML) or built-in cell name")
     p.add_argument("--tour", type=Path, metavar="tour.json", help="the tour to design for")
-    p.add_argument("-o", "--output", type=Path, required=True, metavar="views.csv")
+    p.add_argument("-o", "--output", type=output_file, required=True, metavar="views.csv")
     p.add_argument(
         "--views", type=non_negative_int, default=0, metavar="N",
         help="number of views (default: three per reference target)",
@@ -163,8 +163,6 @@ def read_views(path: Path, cell: CellConfig) -> list[tuple[str, np.ndarray]]:
 def run_plan_views(args: argparse.Namespace) -> int:
     """Design the reference views, write them, print the predicted residual per stop."""
     cell = load_cell(args.cell)
-    if not args.output.parent.is_dir():
-        raise CellError(f"-o {args.output}: the directory {args.output.parent} does not exist")
     extra = [_target(t, k) for k, t in enumerate(args.try_target)]
     if args.every_s > args.hours * 3600:
         raise CellError(

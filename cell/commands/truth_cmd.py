@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from cell.commands.argtypes import output_file
+from cell.commands.group_help import help_handler
 from cell.config import load_cell
 from cell.errors import CellError
 
@@ -36,10 +38,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     draw.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
     draw.add_argument("--seed", type=int, required=True, help="seed of the draw (>= 0)")
-    draw.add_argument("-o", "--output", required=True, metavar="FILE", help="truth file to write")
+    draw.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        required=True,
+        metavar="FILE",
+        help="truth file to write",
+    )
     draw.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
     draw.set_defaults(handler=run_draw)
-    truth.set_defaults(handler=lambda args: (truth.print_help(), 2)[1])
+    truth.set_defaults(handler=help_handler(truth))
 
 
 def run_draw(args: argparse.Namespace) -> int:

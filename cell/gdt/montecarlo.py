@@ -13,7 +13,12 @@ each hole, :func:`gdt_extra`). The components are drawn as they act in a run:
   each hole's centre through its own covariance in the left camera frame and that stop's
   ``R_part_left``;
 - ``part_temperature``: one scale error for the whole part (its expansion about the part
-  origin): one draw per run along each hole's own direction.
+  origin): one draw per run along each hole's own direction;
+- ``cell_calibration`` (a run with ``--calibration``): one error of the calibration's
+  parameters for the whole run, ``z ~ N(0, I_p)``, mapped into each hole's centre through the
+  factor the run stored with it (``cell_calibration_factor_part``, 3 x p: the hole's
+  sensitivity to the parameters times a square root of their covariance), so the part of it
+  that moves every hole together (a rigid motion) cancels in a datum frame.
 
 A result stored before the components were kept has only its total (or only the projected
 ``u_position_m``, taken as an isotropic standard deviation per axis) and is drawn
@@ -81,8 +86,8 @@ def _chol(S: np.ndarray) -> np.ndarray:
     return v * np.sqrt(np.clip(w, 0.0, None))
 
 
-def _error_draws(r: HoleResult, z_cal: np.ndarray, z_temp: np.ndarray,
-                 rng: np.random.Generator) -> np.ndarray:  # fmt: skip
+def _error_draws(r: HoleResult, z_cal: np.ndarray, z_temp: np.ndarray, rng: np.random.Generator,
+                 z_cell: _SharedDraws | None = None) -> np.ndarray:  # fmt: skip
     """Draws ``(n, 3)`` of a centre's error (m), see the module doc."""
     n = len(z_temp)
     parts = r.extra.get("cov_components_part_m2")
@@ -100,7 +105,25 @@ def _error_draws(r: HoleResult, z_cal: np.ndarray, z_temp: np.ndarray,
         vec = v[:, -1] * np.sqrt(max(w[-1], 0.0))
         vec = vec if vec @ np.asarray(r.center_part_m) >= 0 else -vec
         err += z_temp[:, None] * vec
+    A = r.extra.get("cell_calibration_factor_part")
+    if A is not None and "cell_calibration" in parts and z_cell is not None:
+        A = np.asarray(A, float)
+        err += z_cell.get(A.shape[1]) @ A.T
     return err
+
+
+class _SharedDraws:
+    """Standard normal draws ``(n, p)`` shared by every hole of a run (one per dimension
+    ``p``), from their own stream so runs without them draw as before."""
+
+    def __init__(self, n: int, seed: int) -> None:
+        self.n, self.seed = n, seed
+        self._z: dict[int, np.ndarray] = {}
+
+    def get(self, p: int) -> np.ndarray:
+        if p not in self._z:
+            self._z[p] = np.random.default_rng([self.seed, 18, p]).standard_normal((self.n, p))
+        return self._z[p]
 
 
 def draw_centres(results: list[HoleResult], n: int, seed: int) -> dict[str, np.ndarray]:
@@ -108,12 +131,13 @@ def draw_centres(results: list[HoleResult], n: int, seed: int) -> dict[str, np.n
     first draw of each is the measured value itself (the estimate)."""
     rng = np.random.default_rng(seed)
     z_cal, z_temp = rng.standard_normal((n, 3)), rng.standard_normal(n)
+    z_cell = _SharedDraws(n, seed)
     out = {}
     for r in results:
         if not r.measured:
             continue
         c = np.asarray(r.center_part_m, float)
-        d = c + _error_draws(r, z_cal, z_temp, rng)
+        d = c + _error_draws(r, z_cal, z_temp, rng, z_cell)
         d[0] = c
         out[r.hole_id] = d
     return out

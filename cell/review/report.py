@@ -25,6 +25,7 @@ from cell.gdt.report_fields import report_evaluation
 from cell.review.qif.run_file import write_run_qif
 from cell.review.report_html import render_html
 from cell.review.store import Store
+from cell.run.calibration import calibration_summary
 from cell.run.results import HoleResult
 from cell.uncertainty.budget import COMPONENTS
 from cell.uncertainty.decision import CONFORMING, INCONCLUSIVE, NONCONFORMING
@@ -65,6 +66,7 @@ def summary(store: Store) -> dict[str, Any]:
         "holes_nonconforming": sum(r.decision == NONCONFORMING for r in results),
         "decision_rule": next((r.decision_rule for r in results if r.decision_rule), None),
         "part": store.part_state(),
+        "calibration": calibration_summary(store.path.parent),
         "max_U_position_m": max(
             (r.U_position_m for r in measured if r.U_position_m is not None), default=None
         ),

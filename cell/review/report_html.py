@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from cell.review.svg import COLORS, SERIES, Axes, frame, line, svg, text, ticks
+from cell.run.calibration import describe
 from cell.run.results import HoleResult
 from cell.uncertainty.budget import COMPONENTS
 
@@ -62,6 +63,7 @@ def _header(summ: dict[str, Any], info: dict[str, Any], operator: str,
             ("Finished", _date(summ["finished_at"])),
             ("Operator", operator or "_" * 28 + "   signature " + "_" * 20),
             ("Part temperature", ptemp), ("Arm temperatures", arm),
+            ("Cell calibration", describe(summ.get("calibration"))),
             ("Reference temperature", "20 degC (ISO 1): every position and diameter is reported "
                                       "at 20 degC"),
             ("Decision rule", (summ.get("decision_rule") or "-") + " (ISO 14253-1: conformance "

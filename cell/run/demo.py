@@ -24,19 +24,26 @@ import numpy as np
 from cell.config import CellConfig, load_builtin_cell
 from cell.link.client import ControllerClient
 from cell.review.report import write_report
+from cell.run.calibration import RunCalibration, load_run_calibration
+from cell.run.demo_calibrate import (
+    DemoCalibration,
+    calibrate_demo_cell,
+    calibrate_demo_cell_images,
+    plan_demo_caltour,
+)
+from cell.run.demo_truth import DatumError, TruthError, datum_truth_error, truth_error
 from cell.run.reference import plan_reference_tour
-from cell.run.results import HoleResult, deviations
 from cell.run.runner import Progress, Runner, RunOptions, RunResult
 from cell.run.setup import RunFiles, check_new_run_dir, start_run
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.truth import CellTruth
-from cell.sim.world import SimWorld, WorldOptions
+from cell.sim.world import WorldOptions
 from cell.uncertainty.decision import DEFAULT_RULE
 from cell.uncertainty.repeatability import repeatability_rp_m
 from planner import Options, Tour, TourPlanner
+from planner.calibration import CalibrationTour, caltour_from_dict
 from planner.tour import tour_from_dict
-from robots.transforms import invert
 
 
 @dataclass(frozen=True)
@@ -58,9 +65,21 @@ class DemoOptions:
             the arm scatters by its data-sheet repeatability, the true head differs from its
             calibration by a draw from the calibration's uncertainty, the part's expansion
             coefficient by a draw from its material's (False: a perfect arm and head, no
-            geometric error: :meth:`CellTruth.zero`).
+            geometric error: :meth:`CellTruth.zero`, and no calibration).
+        geometry_errors: without a ``truth``, the realistic cell also has the geometric errors
+            of a real one, drawn from the seed (:meth:`CellTruth.drawn`: D-H, head mount, base,
+            part and plate placement); False: none (the demo before issue 18).
+        calibrate: run the cell calibration on the simulated cell first and measure the part
+            with it (False: ``--no-calibration``, the nominal kinematics).
+        calibration_views: views of the plate of that calibration.
+        calibration_method: ``"projected"`` (default): the plate's corners projected at the
+            planner's views (seconds; :mod:`cell.run.demo_calibrate`); ``"images"``: the
+            calibration tour driven on the simulated cell, the plate rendered and detected
+            (``calibrate cell``'s procedure; minutes while the plate renders slowly).
+        calibration_speed: simulation speed while the calibration tour is driven (the
+            simulated arm warms with the simulated time, so 1: the tour's real time).
         truth: every hidden error of the simulated cell (a truth file, ``--truth``); None:
-            no geometric error, and with ``realistic`` the repeatability and head draw above.
+            the drawn truth above (or, without ``geometry_errors``, no geometric error).
         decision_rule: the run's decision rule.
         operator: the report's operator field.
     """
@@ -75,6 +94,11 @@ class DemoOptions:
     thermometer_sigma_K: float = 0.1  # noqa: N815 (unit suffix)
     u_part_temperature_K: float = 0.2  # noqa: N815 (unit suffix)
     realistic: bool = True
+    geometry_errors: bool = True
+    calibrate: bool = True
+    calibration_views: int = 120
+    calibration_method: str = "projected"
+    calibration_speed: float = 1.0
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
     truth: CellTruth | None = None
@@ -82,26 +106,6 @@ class DemoOptions:
 
 #: the demo's part temperature without a truth file or a figure (degC)
 DEMO_PART_TEMPERATURE_C = 23.0
-
-
-@dataclass
-class TruthError:
-    """Measured minus true hole centres (m, part frame, at 20 degC) over the measured holes;
-    ``coverage``: the fraction of measured characteristics (position deviation and diameter of
-    each hole) whose true value lies within the stated expanded uncertainty (NaN: none)."""
-
-    rms_m: float
-    max_m: float
-    rms_uncompensated_m: float
-    diameter_rms_m: float
-    n: int
-    coverage: float = float("nan")
-    n_covered: int = 0
-    n_characteristics: int = 0
-    position_covered: list[bool] = field(default_factory=list)
-    diameter_covered: list[bool] = field(default_factory=list)
-    rms_in_plane_m: float = float("nan")
-    max_in_plane_m: float = float("nan")
 
 
 @dataclass
@@ -114,41 +118,8 @@ class DemoResult:
     summary: dict[str, Any]
     truth: TruthError
     timings: dict[str, float]
-
-
-def truth_error(world: SimWorld, results: list[HoleResult]) -> TruthError:
-    """Measurement error against the simulation's true holes (their 20 degC geometry), and the
-    coverage of the stated uncertainties: ``|d - d_true| <= U_position`` for the position
-    deviation (in the plane of the nominal axis) and ``|D - D_true| <= U_diameter``."""
-    T_part_cell = invert(world.T_cell_part)  # the true part frame: the part as it lies
-    normals = {h.id: np.asarray(h.normal, float) for h in world.cell.part.holes}
-    e, e_u, e_d, e_p, cov_p, cov_d = [], [], [], [], [], []
-    for r in results:
-        if r.center_part_m is None:
-            continue
-        h = world.holes[r.hole_id]
-        true_c = T_part_cell[:3, :3] @ h.position_m + T_part_cell[:3, 3]
-        e.append(np.linalg.norm(np.array(r.center_part_m) - true_c))
-        e_u.append(np.linalg.norm(np.array(r.extra["center_part_uncompensated_m"]) - true_c))
-        e_d.append(r.diameter_m - h.diameter_m)
-        n = normals[r.hole_id]
-        err = np.array(r.center_part_m) - true_c
-        e_p.append(np.linalg.norm(err - (err @ n) * n))
-        if r.U_position_m is not None:
-            nom = np.array(r.nominal_part_m)
-            d_true = deviations(true_c, h.diameter_m, nom, r.nominal_diameter_m, None,
-                                normals[r.hole_id])[0]  # fmt: skip
-            cov_p.append(bool(abs(r.position_deviation_m - d_true) <= r.U_position_m))
-            cov_d.append(bool(abs(r.diameter_m - h.diameter_m) <= r.U_diameter_m))
-
-    def rms(v: list[float]) -> float:
-        return float(np.sqrt(np.mean(np.square(v)))) if v else float("nan")
-
-    covered = cov_p + cov_d
-    cov = float(np.mean(covered)) if covered else float("nan")
-    return TruthError(rms(e), float(max(e, default=float("nan"))), rms(e_u), rms(e_d), len(e),
-                      cov, int(np.sum(covered)), len(covered), cov_p, cov_d, rms(e_p),
-                      float(max(e_p, default=float("nan"))))  # fmt: skip
+    datum: DatumError | None = None
+    calibration: DemoCalibration | None = None
 
 
 def _plan_reference(seed: int) -> dict[str, Any]:
@@ -158,18 +129,24 @@ def _plan_reference(seed: int) -> dict[str, Any]:
 
 
 def plan_demo(
-    cell: CellConfig, seed: int, plan_progress: Callable[[str, int, int], None] | None = None
-) -> tuple[Tour, Tour]:
-    """The hole tour and the reference tour of ``cell``; the reference tour is planned in a
-    second process while this one plans the holes. The second process is started by a fork
-    server, not forked from this one: a process that has run a simulator or a planner holds
-    threads (and their locks) that a forked child would inherit locked."""
+    cell: CellConfig,
+    seed: int,
+    plan_progress: Callable[[str, int, int], None] | None = None,
+    caltour_views: int = 0,
+) -> tuple[Tour, Tour, CalibrationTour | None]:
+    """The hole tour, the reference tour and (``caltour_views`` > 0) the calibration tour of
+    ``cell``; the other two are planned in worker processes while this one plans the holes.
+    The workers are started by a fork server, not forked from this one: a process that has
+    run a simulator or a planner holds threads (and their locks) that a forked child would
+    inherit locked."""
     ctx = multiprocessing.get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as pool:
+    with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
         ref_job = pool.submit(_plan_reference, seed)
+        cal_job = pool.submit(plan_demo_caltour, caltour_views, seed) if caltour_views else None
         tour = TourPlanner(Options(seed=seed), plan_progress).plan(cell)
         reference = tour_from_dict(ref_job.result(), "reference tour")
-    return tour, reference
+        caltour = None if cal_job is None else caltour_from_dict(cal_job.result(), "caltour")
+    return tour, reference, caltour
 
 
 def run_demo(
@@ -185,7 +162,9 @@ def run_demo(
     opts = options or DemoOptions()
     t0 = time.perf_counter()
     cell = load_builtin_cell()
-    tour, reference = plan_demo(cell, opts.seed, plan_progress)
+    images = opts.calibrate and opts.realistic and opts.calibration_method == "images"
+    tour, reference, caltour = plan_demo(cell, opts.seed, plan_progress,
+                                         opts.calibration_views if images else 0)  # fmt: skip
     t_plan = time.perf_counter() - t0
     # real time until the first reference round starts (its readings are the cold state)
     world = demo_world(cell, opts)
@@ -193,16 +172,39 @@ def run_demo(
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
         try:
-            result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder)
+            cal, run_cal = _calibration(sim, files, opts, caltour)
+            result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder,
+                              run_cal)  # fmt: skip
             truth = truth_error(sim.world, files.store.results())
+            results = files.store.results()
         finally:
             files.store.close()
             if recorder is not None:
                 recorder.close()
     summary = write_report(out_dir, opts.operator)
+    datum = datum_truth_error(sim.world, results, Path(out_dir))
     timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
+               "calibration_s": cal.seconds if cal else 0.0,
                "total_s": time.perf_counter() - t0}  # fmt: skip
-    return DemoResult(Path(out_dir), tour, result, summary, truth, timings)
+    return DemoResult(Path(out_dir), tour, result, summary, truth, timings, datum, cal)
+
+
+def _calibration(
+    sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None
+) -> tuple[DemoCalibration | None, RunCalibration | None]:
+    """Calibrate the simulated cell (``opts.calibrate`` and a realistic cell), write the
+    calibration into the run directory and load it back as the run does (checked)."""
+    if not (opts.calibrate and opts.realistic):
+        return None, None
+    run_dir = files.store.path.parent
+    if caltour is not None:
+        cal = calibrate_demo_cell_images(sim, files.cell, caltour, run_dir,
+                                         opts.calibration_speed)  # fmt: skip
+    else:
+        cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
+                                  opts.seed)  # fmt: skip
+    arm = files.cell.build_robot()
+    return cal, load_run_calibration(cal.path, files.cell, arm, sim.camera.stereo)
 
 
 def demo_world(cell: CellConfig, opts: DemoOptions) -> WorldOptions:
@@ -221,11 +223,16 @@ def demo_world(cell: CellConfig, opts: DemoOptions) -> WorldOptions:
 
 def demo_truth(cell: CellConfig, opts: DemoOptions) -> CellTruth:
     """``opts.truth`` (its part temperature replaced by ``part_temperature_c`` if given); without
-    one no geometric error and, with ``realistic``, the arm's data-sheet repeatability and a
-    head off its calibration by a draw of its stated uncertainty."""
+    one and with ``realistic``: the realistic draw of the seed (:meth:`CellTruth.drawn`), or
+    without ``geometry_errors`` no geometric error, the arm's data-sheet repeatability and a
+    head off its calibration by a draw of its stated uncertainty; without ``realistic``:
+    :meth:`CellTruth.zero`."""
     t = opts.part_temperature_c
     if opts.truth is not None:
         return opts.truth if t is None else replace(opts.truth, part_temperature_c=t)
+    if opts.realistic and opts.geometry_errors:
+        drawn = CellTruth.drawn(opts.seed, cell)
+        return drawn if t is None else replace(drawn, part_temperature_c=t)
     truth = replace(CellTruth.zero(opts.seed),
                     part_temperature_c=DEMO_PART_TEMPERATURE_C if t is None else t)  # fmt: skip
     if not opts.realistic:
@@ -251,7 +258,12 @@ def _speed_up(sim: SimCell, opts: DemoOptions, run_progress: Progress | None) ->
 
 
 def _run_sim(
-    sim: SimCell, files: RunFiles, opts: DemoOptions, progress: Progress, recorder: Any
+    sim: SimCell,
+    files: RunFiles,
+    opts: DemoOptions,
+    progress: Progress,
+    recorder: Any,
+    calibration: RunCalibration | None = None,
 ) -> RunResult:
     """Run the stored tour on the simulated cell over its port."""
     run_opts = RunOptions(
@@ -264,5 +276,5 @@ def _run_sim(
     )
     with ControllerClient(sim.url) as client:
         runner = Runner(files.cell, files.tour, files.store, client, sim.camera, run_opts,
-                        files.reference, None, progress, recorder)  # fmt: skip
+                        files.reference, None, progress, recorder, calibration)  # fmt: skip
         return runner.run()

@@ -20,6 +20,7 @@ import numpy as np
 
 from cell.config import CellConfig, HoleInCell
 from cell.gdt.montecarlo import gdt_extra
+from cell.run.calibration import RunGeometry
 from cell.run.results import HoleResult, deviations
 from cell.uncertainty.budget import combine
 from cell.uncertainty.context import BudgetContext, budget_context, hole_contributions
@@ -33,10 +34,12 @@ from robots.transforms import invert
 
 
 def T_cell_tcp(
-    arm: Arm, model: ThermalModel | None, q_rad: np.ndarray, temps_c: np.ndarray
+    arm: Arm | RunGeometry, model: ThermalModel | None, q_rad: np.ndarray, temps_c: np.ndarray
 ) -> np.ndarray:
-    """TCP pose in the cell: compensated if a thermal model is given, nominal otherwise; always
-    with the cell's base pose and tool (the model was checked against them when loaded)."""
+    """TCP pose in the cell: compensated if a thermal model is given, else the kinematics of
+    ``arm`` (the nominal arm, or the run's :class:`RunGeometry`: calibrated D-H table, base and
+    head); always with its base pose and tool (the model was identified on them or checked
+    against them when loaded)."""
     if model is None:
         return arm.fk(q_rad, "tcp")
     return compensated_T_cell_tcp(model, arm.T_cell_base, arm.T_tool0_tcp, q_rad, temps_c)
@@ -44,7 +47,7 @@ def T_cell_tcp(
 
 def inspect_hole(
     cell: CellConfig,
-    arm: Arm,
+    arm: Arm | RunGeometry,
     model: ThermalModel | None,
     stereo: StereoCalibration,
     hole: HoleInCell,
@@ -59,7 +62,9 @@ def inspect_hole(
     """Measure ``hole`` from one pair and compare it with its nominal; never raises for a hole
     that is not there (``missing``) or cannot be measured (``unmeasured``: a resume retries
     it). ``context``: the run's budget inputs (default: the cell's, part temperature from the
-    cell file or assumed, ISO 14253-1 rule)."""
+    cell file or assumed, ISO 14253-1 rule). ``arm``: the kinematics the measurement is carried
+    through (a :class:`RunGeometry` with a calibration adds its ``cell_calibration`` budget
+    row)."""
     T_part_cell = invert(cell.T_cell_part())
     nominal = T_part_cell[:3, :3] @ hole.position_m + T_part_cell[:3, 3]
     base = _base_fields(hole, stop_index, nominal, q_rad, temps_c, sim_time_s)
@@ -86,14 +91,33 @@ def inspect_hole(
     normal_part = T_part_cell[:3, :3] @ hole.normal
     result = _measured(meas, T_part_left, hole, nominal, t_meas, extra, base, ctx, normal_part)
     center_tcp = T_head_left[:3, :3] @ meas.center_m + T_head_left[:3, 3]
+    cal_A, cal_note = _calibration_factor(arm, q_rad, meas.center_m, T_part_cell[:3, :3])
+    cal_cov = None if cal_A is None else cal_A @ cal_A.T
     contributions = hole_contributions(
         ctx, stereo, meas, T_part_left[:3, :3], T_part_cell[:3, :3], model, arm.T_cell_base,
         arm.T_tool0_tcp, q_rad, temps_c, center_tcp, np.array(result.center_part_m),
-        result.diameter_m)  # fmt: skip
+        result.diameter_m, cal_cov, cal_note)  # fmt: skip
     delta = np.array(result.center_part_m) - nominal
     budget = combine(contributions, delta, normal_part, (ctx.part.note(),))
-    result = replace(result, extra={**result.extra, **gdt_extra(contributions, T_part_left)})
+    extra = {**result.extra, **gdt_extra(contributions, T_part_left)}
+    if cal_A is not None:  # the shared calibration error's factor, for the datum-frame draws
+        extra["cell_calibration_factor_part"] = cal_A.tolist()
+    result = replace(result, extra=extra)
     return _decided(result, budget, ctx.rule), meas
+
+
+def _calibration_factor(
+    arm: Arm | RunGeometry, q_rad: np.ndarray, center_left_m: np.ndarray, R_part_cell: np.ndarray
+) -> tuple[np.ndarray | None, str]:
+    """The cell calibration's error factor of the centre (3, p, part frame: error ``A z``,
+    ``z ~ N(0, I)`` shared by the run) and its note; None without a calibration."""
+    if not isinstance(arm, RunGeometry) or arm.run_calibration is None:
+        return None, ""
+    A = R_part_cell @ arm.point_factor_cell(q_rad, center_left_m)
+    rc = arm.run_calibration
+    note = (f"{rc.source} ({rc.calibration.created_utc}): hand-eye, D-H terms and plate pose, "
+            "first order with their correlations, relative to the plate")  # fmt: skip
+    return A, note
 
 
 def _decided(result: HoleResult, budget, rule: str) -> HoleResult:

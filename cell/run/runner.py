@@ -24,7 +24,9 @@ from cell.errors import CellError
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError
 from cell.review.store import Store
+from cell.run.calibration import RunCalibration, RunGeometry, calibrated_stereo
 from cell.run.camera import CameraBackend
+from cell.run.corrected_tour import correct_tour
 from cell.run.inspect import T_cell_tcp, inspect_hole
 from cell.run.motion import Motion, RunFaultError, stop_rows  # noqa: F401 (re-exported)
 from cell.run.reference import target_of
@@ -112,6 +114,8 @@ class Runner(Motion):
         thermal_model: ThermalModel | None = None,
         progress: Progress | None = None,
         recorder=None,
+        calibration: RunCalibration | None = None,
+        base_from: str = "cell",
     ) -> None:
         self.cell, self.tour, self.store, self.client, self.camera = (
             cell,
@@ -126,9 +130,21 @@ class Runner(Motion):
         self.progress = progress or (lambda event, data: None)
         self.recorder = recorder
         self.arm = cell.build_arm()
+        target = cell.calibration_target
+        # the head as triangulated: the stereo file, with the calibration's extrinsics if any
+        self.stereo = calibrated_stereo(camera.stereo, calibration)
+        self.geometry = RunGeometry(self.arm, self.stereo, calibration,
+                                    None if target is None else target.T_cell_target(),
+                                    base_from)  # fmt: skip
+        # the commanded poses: the planned stops corrected for the calibration (unchanged
+        # without one); the thermal model identifies on the calibrated geometry
+        self.tour, self.corrections = correct_tour(tour, self.arm, self.geometry, "tour")
+        if reference_tour is not None:
+            self.reference_tour, _ = correct_tour(reference_tour, self.arm, self.geometry,
+                                                  "reference tour")  # fmt: skip
         self.holes = {h.id: h for h in cell.holes_in_cell()}
-        self.thermal = ThermalUpdate(cell, self.arm)
-        self._T_head_left = invert(head_frame(camera.stereo))
+        self.thermal = ThermalUpdate(cell, self.geometry)
+        self._T_head_left = invert(head_frame(self.stereo))
         self.model_id: int | None = None
         self.budget: BudgetContext | None = None  # set once the reference phase is over
         self._round0 = 0
@@ -154,6 +170,7 @@ class Runner(Motion):
 
     def _run(self, result: RunResult, wait_for_start: Callable[[], None] | None) -> None:
         stored = self.store.done_ids()
+        self._note_calibration()
         self._restore_thermal()
         self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
         if wait_for_start is not None:
@@ -203,6 +220,23 @@ class Runner(Motion):
         if self.recorder is not None:
             self.recorder.state(state)
 
+    def _note_calibration(self) -> None:
+        """Record which calibration the run applies and how far it moved the stops."""
+        rc = self.geometry.run_calibration
+        if rc is None:
+            self.store.event("calibration", "no cell calibration: the cell file's kinematics, "
+                             "base and head mount taken as exact")  # fmt: skip
+            return
+        off = [float(np.linalg.norm(c.offset_m)) for c in self.corrections]
+        dq = [float(np.abs(c.dq_rad).max()) for c in self.corrections]
+        self.store.event(
+            "calibration",
+            f"cell calibration {rc.source} ({rc.calibration.created_utc}, base from the "
+            f"{self.geometry.base_from}): stops corrected by up to {max(dq, default=0.0):.2e} "
+            f"rad (the calibrated head was up to {max(off, default=0.0) * 1e3:.3f} mm off "
+            "the planned pose)",
+        )
+
     # --- thermal state in the store --------------------------------------------------------
     def _restore_thermal(self) -> None:
         """Reload the stored reference observations; use the given model (stored if new) or
@@ -231,7 +265,7 @@ class Runner(Motion):
             self.store.event("part", part.note())
         else:
             part = PartThermalState.from_dict(stored)
-        return budget_context(self.cell, self.camera.stereo, part, o.decision_rule)
+        return budget_context(self.cell, self.stereo, part, o.decision_rule)
 
     # --- reference targets -----------------------------------------------------------------
     def _home_for_reference(self) -> None:
@@ -265,7 +299,7 @@ class Runner(Motion):
                 st = self._settled_status()
                 pair = self.camera.capture()
                 try:
-                    meas = measure_hole(pair.left, pair.right, self.camera.stereo)
+                    meas = measure_hole(pair.left, pair.right, self.stereo)
                 except MeasurementError as exc:
                     self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
                     continue
@@ -314,7 +348,7 @@ class Runner(Motion):
         clock.lap("settle_s")
         pair = self.camera.capture()
         clock.lap("capture_s")
-        result, meas = inspect_hole(self.cell, self.arm, self.model, self.camera.stereo,
+        result, meas = inspect_hole(self.cell, self.geometry, self.model, self.stereo,
                                self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
                                st.temperatures_c, st.time_s, self.budget)  # fmt: skip
         result = replace(result, thermal_model_id=self.model_id if self.model else None)
@@ -322,7 +356,7 @@ class Runner(Motion):
         self.store.record_hole(result)
         clock.lap("store_s")
         if self.recorder is not None:
-            T = T_cell_tcp(self.arm, self.model, st.q_rad, st.temperatures_c)
+            T = T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
             self.recorder.hole(result, meas, pair, st, T @ self._T_head_left)
         clock.lap("record_s")
         self.progress("hole", {"stop": k, "result": result})

@@ -147,7 +147,7 @@ class SimCamera:
         """Render the calibration plate at its true pose in the true head."""
         spec = self.world.cell.calibration_target.target_spec()
         T_left_target = invert(T_cell_left) @ self.world.T_cell_target
-        r = render_target_pair(self.true_stereo, spec, T_left_target, supersample=1, seed=seed)
+        r = render_target_pair(self.true_stereo, spec, T_left_target, seed=seed)
         origin = self.world.T_cell_target[:3, 3].copy()
         self.last_truth = CaptureTruth("calibration_target", "target", T_cell_left, origin, None)
         return StereoPair(r.left, r.right)

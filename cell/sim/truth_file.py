@@ -15,13 +15,18 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from cell.config import PART_TEMPERATURE_RANGE_C, Pose
-from cell.errors import TruthFileError
+from cell.errors import NO_VALUE, TruthFileError
+from cell.yaml_problem import yaml_problem
 
 #: the truth file's format tag (optional in a file; written first)
 FORMAT = "holecell.truth/1"
 #: largest D-H length error (m) and angle error (rad) a truth file may state
 MAX_DH_LENGTH_ERROR_M = 0.01
 MAX_DH_ANGLE_ERROR_RAD = 0.05
+#: rows of ``robot.dh_errors``: one per joint
+DH_ROWS = 6
+#: a value whose repr is longer is shortened in a refusal (one line)
+MAX_VALUE_CHARS = 60
 #: largest translation (m, per axis) and rotation (rad, per rpy angle) of a pose error
 MAX_POSE_ERROR_M = 0.05
 MAX_POSE_ERROR_RAD = 0.1
@@ -61,7 +66,9 @@ class DHErrorSpec(_Strict):
 
 
 class RobotTruth(_Strict):
-    dh_errors: Annotated[list[DHErrorSpec], Field(min_length=6, max_length=6)] | None = None
+    dh_errors: (
+        Annotated[list[DHErrorSpec], Field(min_length=DH_ROWS, max_length=DH_ROWS)] | None
+    ) = None
     base_error: ErrorPose | None = None
     repeatability_rp_m: Sigma | None = None
 
@@ -110,31 +117,79 @@ def _field_path(loc: tuple[Any, ...]) -> str:
     return out or "(top level)"
 
 
+class _Short(str):
+    """A long value's repr cut to :data:`MAX_VALUE_CHARS` (shown as is in a refusal)."""
+
+    def __repr__(self) -> str:
+        return str(self)
+
+
+def _shown(value: object) -> object:
+    text = repr(value)
+    return value if len(text) <= MAX_VALUE_CHARS else _Short(text[: MAX_VALUE_CHARS - 3] + "...")
+
+
+def _problems(exc: ValidationError, prefix: tuple[Any, ...] = ()) -> list[tuple[str, object, str]]:
+    out = []
+    for err in exc.errors():
+        msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key"
+        if err["type"] == "missing":  # pydantic's input is then the mapping around the key
+            msg, err["input"] = "a required key is missing", NO_VALUE
+        out.append((_field_path((*prefix, *err["loc"])), _shown(err.get("input")), msg))
+    return out
+
+
+def _dh_rows(data: dict[str, Any]) -> list[Any] | None:
+    robot = data.get("robot")
+    rows = robot.get("dh_errors") if isinstance(robot, dict) else None
+    return rows if isinstance(rows, list) else None
+
+
+def _dh_count_problems(rows: list[Any]) -> list[tuple[str, object, str]]:
+    """A ``dh_errors`` list of the wrong length: the count, and each row's own problems
+    (pydantic stops at the length and would not name an unknown key inside a row)."""
+    out: list[tuple[str, object, str]] = [
+        ("robot.dh_errors", NO_VALUE, f"{len(rows)} rows: one per joint, {DH_ROWS} rows expected")
+    ]
+    for i, row in enumerate(rows):
+        try:
+            DHErrorSpec.model_validate(row)
+        except ValidationError as exc:
+            out += _problems(exc, ("robot", "dh_errors", i))
+    return out
+
+
 def parse_truth_spec(text: str, source: str) -> TruthSpec:
-    """Validate a truth file's YAML text; raises :class:`TruthFileError` naming each field."""
+    """Validate a truth file's YAML text; raises :class:`TruthFileError` naming each field
+    (one line each; a YAML syntax error with its line and column)."""
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        raise TruthFileError(source, [("(yaml)", None, f"not valid YAML: {exc}")]) from exc
+        raise TruthFileError(source, [yaml_problem(exc)]) from None
     if data is None:
         data = {}
     if not isinstance(data, dict):
-        raise TruthFileError(source, [("(top level)", data, "a truth file is a mapping of keys")])
+        raise TruthFileError(
+            source, [("(top level)", _shown(data), "a truth file is a mapping of keys")]
+        )
     try:
         return TruthSpec.model_validate(data)
     except ValidationError as exc:
-        problems = []
-        for err in exc.errors():
-            msg = err["msg"].removeprefix("Value error, ")
-            if err["type"] == "extra_forbidden":
-                msg = "unknown key"
-            problems.append((_field_path(err["loc"]), err.get("input"), msg))
-        raise TruthFileError(source, problems) from exc
+        problems = _problems(exc)
+        rows = _dh_rows(data)
+        if rows is not None and len(rows) != DH_ROWS:
+            problems = [p for p in problems if p[0] != "robot.dh_errors"]
+            problems = _dh_count_problems(rows) + problems
+        raise TruthFileError(source, problems) from None
 
 
 def read_truth_spec(path: str | Path) -> TruthSpec:
     """Read and validate the truth file at ``path``."""
     p = Path(path)
+    if p.is_dir():
+        raise TruthFileError(str(p), [("(file)", str(p), "is a directory, not a truth file")])
     if not p.is_file():
         raise TruthFileError(str(p), [("(file)", str(p), "no such file")])
     try:

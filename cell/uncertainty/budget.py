@@ -17,7 +17,11 @@ exceeds the in-plane error). ``U = k u`` with ``k = 2``.
 Components (names as stored): ``circle_fit`` (the fit's covariance), ``stereo_calibration``
 (:mod:`cell.uncertainty.calibration`), ``thermal_model`` (:mod:`cell.uncertainty.thermal`),
 ``robot_repeatability`` (:mod:`cell.uncertainty.repeatability`), ``part_temperature``
-(:mod:`cell.uncertainty.part_temperature`), and ``nonlinearity`` (the second-order term).
+(:mod:`cell.uncertainty.part_temperature`), ``cell_calibration`` (a run with ``--calibration``:
+the hand-eye and D-H terms' joint covariance carried to the hole's centre, first order,
+:meth:`cell.run.calibration.RunGeometry.point_covariance_cell`; without one the cell file's
+kinematics, base and head mount are taken as exact and the row is absent), and
+``nonlinearity`` (the second-order term).
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ import numpy as np
 #: coverage factor of the expanded uncertainty (about 95 % for a normal distribution)
 K_COVERAGE = 2.0
 COMPONENTS = ("circle_fit", "stereo_calibration", "thermal_model", "robot_repeatability",
-              "part_temperature", "nonlinearity")  # fmt: skip
+              "part_temperature", "cell_calibration", "nonlinearity")  # fmt: skip
 
 
 @dataclass(frozen=True)

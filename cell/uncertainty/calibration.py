@@ -18,8 +18,10 @@ edge points under a changed calibration:
 
 The refit of step 2 is the algebraic fit (least-squares plane, then the linear Kasa circle in
 it): for points on a circle it has the sensitivity of the orthogonal fit, at a fraction of the
-cost. The left camera's pose relative to the TCP is the hand-eye calibration's and is taken as
-known here: the calibration moves points within the left camera frame.
+cost. The left camera's pose relative to the TCP is the hand-eye calibration's: this component
+moves points within the left camera frame only; the hand-eye's (and the arm's D-H terms')
+uncertainty is the budget's ``cell_calibration`` component when the run applies a cell
+calibration (:mod:`cell.run.calibration`).
 
 A calibration without an uncertainty block gets :func:`default_uncertainty` (figures of a
 careful calibration with a certified target, scaled to the head's focal length and baseline),

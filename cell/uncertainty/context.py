@@ -73,8 +73,13 @@ def hole_contributions(
     center_tcp_m: np.ndarray,
     center_part_20_m: np.ndarray,
     diameter_20_m: float,
+    cell_calibration_cov_m2: np.ndarray | None = None,
+    cell_calibration_note: str = "",
 ) -> list[Contribution]:
-    """The five contributions of one measured hole (see :mod:`cell.uncertainty.budget`)."""
+    """The contributions of one measured hole (see :mod:`cell.uncertainty.budget`): five, and
+    ``cell_calibration`` when the run applies a cell calibration (``cell_calibration_cov_m2``:
+    the centre's covariance in the part frame, m^2, from the calibration's covariance:
+    :meth:`cell.run.calibration.RunGeometry.point_covariance_cell` rotated into the part)."""
     cov = np.asarray(meas.cov_center_radius, float)
     fit = Contribution("circle_fit", R_part_left @ cov[:3, :3] @ R_part_left.T, 4.0 * cov[3, 3],
                        f"covariance of the circle fit ({int(meas.n_points)} points)")  # fmt: skip
@@ -96,4 +101,8 @@ def hole_contributions(
     c20 = np.asarray(center_part_20_m, float)
     temp = Contribution("part_temperature", rel * rel * np.outer(c20, c20),
                         (rel * diameter_20_m) ** 2, ctx.part.note())  # fmt: skip
-    return [fit, calib, thermal, rep, temp]
+    out = [fit, calib, thermal, rep, temp]
+    if cell_calibration_cov_m2 is not None:
+        out.append(Contribution("cell_calibration", np.asarray(cell_calibration_cov_m2, float),
+                                0.0, cell_calibration_note))  # fmt: skip
+    return out

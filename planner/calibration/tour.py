@@ -14,14 +14,11 @@ parameter (``prediction``). SI units: m, rad, s; poses ``{xyz, quat_xyzw}``.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from planner.calibration.candidates import Candidates
 from planner.errors import TourFileError
@@ -30,20 +27,11 @@ from planner.planner import ProgressCallback, TourPlanner
 from planner.protocols import ArmLike, CellLike
 from planner.tour import FORMAT as TOUR_FORMAT
 from planner.tour import FORMAT_VERSION as TOUR_VERSION
-from planner.tour import LeftOut, Tour, tour_from_dict
+from planner.tour import LeftOut, Tour, pose_dict, read_json_object, tour_from_dict, write_json
 from planner.viewpoints import HoleCandidates
 
 FORMAT = "holecell.caltour"
 FORMAT_VERSION = 1
-
-
-def pose_dict(T: NDArray[np.float64]) -> dict[str, list[float]]:
-    """A 4×4 transform as ``{xyz, quat_xyzw}`` (m)."""
-    T = np.asarray(T, dtype=float)
-    return {
-        "xyz": [float(v) for v in T[:3, 3]],
-        "quat_xyzw": [float(v) for v in Rotation.from_matrix(T[:3, :3]).as_quat()],
-    }
 
 
 def view_ids(n: int) -> list[str]:
@@ -141,11 +129,7 @@ class CalibrationTour:
 
     def save(self, path: str | Path) -> Path:
         """Write ``caltour.json`` via a temporary name (an existing file is never half-written)."""
-        target = Path(path)
-        tmp = target.with_name(target.name + ".tmp")
-        tmp.write_text(json.dumps(self.to_dict(), indent=1))
-        tmp.replace(target)
-        return target
+        return write_json(path, self.to_dict())
 
 
 def caltour_from_dict(data: dict[str, Any], where: str = "<caltour>") -> CalibrationTour:
@@ -169,13 +153,4 @@ def caltour_from_dict(data: dict[str, Any], where: str = "<caltour>") -> Calibra
 
 def load_caltour(path: str | Path) -> CalibrationTour:
     """Read ``caltour.json``; a missing or malformed file raises :class:`TourFileError`."""
-    p = Path(path)
-    try:
-        data = json.loads(p.read_text())
-    except FileNotFoundError as exc:
-        raise TourFileError(str(p), "file", "not found") from exc
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise TourFileError(str(p), "file", f"not readable as JSON ({exc})") from exc
-    if not isinstance(data, dict):
-        raise TourFileError(str(p), "file", "expected a JSON object")
-    return caltour_from_dict(data, str(p))
+    return caltour_from_dict(read_json_object(path), str(Path(path)))

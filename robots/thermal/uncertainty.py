@@ -18,18 +18,45 @@ temperature rise over the reference, and is zero at the reference temperatures.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from robots.dh import DHTable
 from robots.thermal.errors import ThermalSpecError
-from robots.thermal.model import TERM_SCALE, coefficient_vectors, fk_rows, term_kind_and_link
+from robots.thermal.spec import (
+    TERM_SCALE,
+    Array,
+    ThermalSpec,
+    coefficient_vectors,
+    fk_rows,
+    term_kind_and_link,
+)
 
-if TYPE_CHECKING:
-    from robots.thermal.model import ThermalModel
 
-Array = NDArray[np.float64]
+class ThermalModel(Protocol):
+    """What these functions read of an identified model (:class:`robots.thermal.ThermalModel`,
+    which imports this module for its ``predict_covariance``)."""
+
+    @property
+    def table(self) -> DHTable: ...
+    @property
+    def spec(self) -> ThermalSpec: ...
+    @property
+    def coefficients(self) -> Mapping[str, float]: ...
+    @property
+    def std(self) -> Mapping[str, float]: ...
+    @property
+    def covariance(self) -> Array | None: ...
+    @property
+    def fit(self) -> Mapping[str, float]: ...
+    @property
+    def T_cell_base(self) -> Array: ...
+    @property
+    def T_tool0_tcp(self) -> Array: ...
+    def fk(self, q: ArrayLike, temps_degC: ArrayLike) -> Array: ...
 
 
 def covariance_matrix(model: ThermalModel) -> Array:

@@ -172,7 +172,7 @@ def test_calibrate_stereo_and_the_older_form_reach_the_stereo_calibration(capsys
     assert new.handler is calibrate_stereo_cmd.run
     assert old.left == new.left == ["l*.png"] and old.pitch == 0.012
     assert main(["calibrate"]) == 2
-    assert "give a subcommand (stereo, hand-eye, cell)" in capsys.readouterr().err
+    assert "give a subcommand (stereo, hand-eye, cell, example)" in capsys.readouterr().err
 
 
 def test_a_blurred_image_is_refused_unless_a_wider_edge_is_allowed(

@@ -13,7 +13,8 @@ from robots.calibration import (
     term_names,
 )
 from robots.calibration.redundancy import fold_redundant
-from robots.dh import dh_table, fk_dh
+from robots.dh import fk_dh
+from robots.dh_models import dh_table
 
 MODEL = "abb_irb2600_20_165"
 

@@ -10,7 +10,7 @@ from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationE
 from cell.calibration.observations import CalibrationObservations, CalibrationView
 from cell.calibration.solve import solve_calibration
 from cell.calibration.synthetic import example_truth, reference_joints, simulate
-from robots.dh import dh_table
+from robots.dh_models import dh_table
 
 
 def _views(tr, Q, seen=None):

@@ -35,7 +35,7 @@ def _run(sc: SmallCell, run_dir: Path, sim: SimCell, resume: bool = False, **opt
     options = RunOptions(
         settle_s=0.0,
         reference_rounds=opts.pop("rounds", 0),
-        reference_interval_s=600.0,
+        reference_interval_s=opts.pop("interval_s", 600.0),
         reconnect_budget_s=5.0,
     )
     runner = Runner(
@@ -126,11 +126,13 @@ def test_estop_during_the_reference_rounds_resumes(
         small_cell.cell, WorldOptions(speed=20.0), faults, controller=controller_rapid_slow
     ) as sim:
         with pytest.raises(RunFaultError, match="reference"):
-            _run(small_cell, tmp_path, sim, rounds=2)
+            _run(small_cell, tmp_path, sim, rounds=2, interval_s=60.0)
         with ControllerClient(sim.url, link_for(controller_rapid_slow, FAST_LINK)) as operator:
             operator.reset()
         sim.controller.estop_at_stop = None
-        result, stored, events = _run(small_cell, tmp_path, sim, resume=True, rounds=2)
+        result, stored, events = _run(
+            small_cell, tmp_path, sim, resume=True, rounds=2, interval_s=60.0
+        )
     assert result.status == "done"
     assert [r.hole_id for r in stored] == small_cell.tour.hole_order
     assert any("along the reference tour" in e.get("message", "") for e in events)

@@ -182,9 +182,11 @@ def test_demo_world_takes_the_truth(cell) -> None:
     ideal = demo_truth(cell, DemoOptions(realistic=False, seed=4))
     assert ideal.is_geometrically_zero() and ideal.repeatability_rp_m == 0.0
     assert ideal.seed == 4 and ideal.part_temperature_c == 23.0
-    today = demo_truth(cell, DemoOptions())  # no truth file: the errors the demo had before
-    assert today.is_geometrically_zero() and today.calibration_sigma_scale == 1.0
-    assert today.repeatability_rp_m > 0
+    drawn = demo_truth(cell, DemoOptions(seed=8))  # no truth file: the realistic draw
+    assert np.array_equal(drawn.dh_errors, t.dh_errors) and not drawn.is_geometrically_zero()
+    before = demo_truth(cell, DemoOptions(geometry_errors=False))  # the demo before issue 18
+    assert before.is_geometrically_zero() and before.calibration_sigma_scale == 1.0
+    assert before.repeatability_rp_m > 0
     assert not t.is_geometrically_zero()
 
 

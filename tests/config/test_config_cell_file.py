@@ -134,7 +134,7 @@ def test_missing_file_and_bad_yaml(tmp_path: Path) -> None:
         load_cell(tmp_path / "absent.yaml")
     bad = tmp_path / "bad.yaml"
     bad.write_text("name: [unclosed\n")
-    with pytest.raises(ConfigError, match=r"bad.yaml: \(yaml\)"):
+    with pytest.raises(ConfigError, match=r"bad.yaml: line 2, column 1: not valid YAML: expected"):
         load_cell(bad)
 
 

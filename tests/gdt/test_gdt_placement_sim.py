@@ -23,7 +23,7 @@ from robots.transforms import invert
 
 def _demo(out: Path, T_err: np.ndarray | None) -> tuple[dict, object]:
     cell = load_builtin_cell()
-    opts = DemoOptions(seed=3)
+    opts = DemoOptions(seed=3, geometry_errors=False, calibrate=False)  # the placement alone
     tr = demo_truth(cell, opts)
     opts = replace(opts, truth=tr if T_err is None else replace(tr, part_placement_error=T_err))
     run_demo(out, opts)

@@ -54,8 +54,11 @@ def test_round_trip_returns_the_configuration(name: str) -> None:
         assert np.all(result.solutions >= lower) and np.all(result.solutions <= upper)
 
 
-@pytest.mark.parametrize("name", NAMES)
-def test_every_branch_found_by_numerical_search(name: str) -> None:
+@pytest.mark.parametrize(
+    ("name", "starts"),
+    [(n, 20) for n in NAMES] + [pytest.param(n, 40, marks=pytest.mark.slow) for n in NAMES],
+)
+def test_every_branch_found_by_numerical_search(name: str, starts: int) -> None:
     spec = MODELS[name]
     table = dh_table(name)
     lower, upper = spec.limits()
@@ -63,7 +66,7 @@ def test_every_branch_found_by_numerical_search(name: str) -> None:
     for trial, q in enumerate(rng.uniform(lower, upper, (2, 6))):
         T = fk_dh(table, q)
         analytic = solve_ik(table, T, lower, upper).solutions
-        numeric = _numerical_solutions(table, T, lower, upper, starts=40, seed=trial)
+        numeric = _numerical_solutions(table, T, lower, upper, starts=starts, seed=trial)
         assert len(numeric) > 0
         for qn in numeric:
             # every numerically found solution is one of the closed-form ones (same joint values)

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robots.dh import DHTable, dh_table, fk_dh
+from robots.dh import DHTable, fk_dh
+from robots.dh_models import dh_table
 from robots.thermal import CellGeometry
 from robots.transforms import pose_to_matrix
 

@@ -31,7 +31,10 @@ def small(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 
 def _cli(args: list[str], capsys) -> tuple[int, str, str]:
-    code = main(["thermal", "plan-views", *args])
+    try:
+        code = main(["thermal", "plan-views", *args])
+    except SystemExit as exc:  # a command-line mistake (-o in no folder): argparse's exit
+        code = exc.code
     out, err = capsys.readouterr()
     return code, out, err
 

@@ -55,8 +55,10 @@ def find_runs(paths: Sequence[str | Path]) -> list[Path]:
             files += inner
         elif p.is_dir():
             raise SpcError(f"{p}: no report.qif in it or in its sub-folders")
+        elif not p.exists():
+            raise SpcError(f"{p}: no such file or folder")
         else:
-            raise SpcError(f"{p}: not a run directory")
+            raise SpcError(f"{p}: a file, not a run directory (give the folder holding report.qif)")
     if not files:
         raise SpcError("no runs given")
     return files

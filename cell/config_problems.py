@@ -1,0 +1,35 @@
+"""Validation errors of the cell file as ``(field path, value, message)`` problems, the form
+of :class:`cell.errors.ConfigError`. (``cell/sim/truth_file.py`` has its own copy, being
+reworked on another branch; to be made one with this after that lands.)"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import ValidationError
+
+from cell.errors import NO_VALUE
+
+
+def field_path(loc: tuple[Any, ...]) -> str:
+    """A pydantic error location as the file's field path: ``part.holes[3].normal``."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += f".{part}" if out else str(part)
+    return out or "(top level)"
+
+
+def pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
+    """Every error of ``exc`` as ``(field path, value, message)``; an unknown key says so."""
+    problems = []
+    for err in exc.errors():
+        msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key"
+        if err["type"] == "missing":  # pydantic's input is then the mapping around the key
+            msg, err["input"] = "a required key is missing", NO_VALUE
+        problems.append((field_path(err["loc"]), err.get("input"), msg))
+    return problems
