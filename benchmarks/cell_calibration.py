@@ -16,6 +16,8 @@ Per seed and variant, before (the nominal cell) and after:
   volume (random points in the holes' bounding box, each viewed along a hole's normal at the
   standoff with a random roll, IK nearest that hole's tour configuration), the model's chain
   against the true one in ``base_link`` (target <= 30 um RMS after);
+- the TCP's stated sigma there (RMS of ``sqrt(trace)`` of the calibration's covariance
+  propagated by ``CalibratedKinematics.point_covariance``);
 - the share of the free parameters within 2 stated sigmas of the truth (target 90-99 %);
 - robot time (the tour's planned time; target <= 180 s) and solve time (target <= 10 s;
   wall and CPU time of this process: the machine may be shared);
@@ -37,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cell.calibration.apply import CalibratedKinematics
 from cell.calibration.observations import Cameras
 from cell.calibration.solve import SolveOptions, pose_error, solve_calibration
 from cell.calibration.synthetic import parameter_errors
@@ -148,6 +151,8 @@ def figures(cell, data: dict, options: SolveOptions, Q: np.ndarray) -> dict:
         e = tcp_errors_m(dh, truth, X, delta, T_left_tcp, Q)
         return float(np.sqrt(np.mean(e**2))), float(e.max())
 
+    ck = CalibratedKinematics(cal)
+    var = [np.trace(ck.point_covariance(q, T_left_tcp[:3, 3], "base")) for q in Q]
     errs = parameter_errors(cal, truth)
     z = np.array([errs[n] / cal.sigma(n) for n in cal.parameter_names])
     out = {
@@ -155,6 +160,7 @@ def figures(cell, data: dict, options: SolveOptions, Q: np.ndarray) -> dict:
         "he": pose_error(cal.T_tool0_camera.T, truth.T_tool0_camera),
         "tcp0": tcp(X0, np.zeros(24)),
         "tcp": tcp(cal.T_tool0_camera.T, cal.delta),
+        "tcp_sigma": float(np.sqrt(np.mean(var))),
         "within2": float(np.mean(np.abs(z) < 2.0)),
         "n_par": len(z),
         "solve_s": res.timings["total_s"],
@@ -234,7 +240,8 @@ def _row(tag: str, v: str, f: dict) -> str:
     cv = "  ".join(f"{f[m][0] * 1e3:.3f}, {np.degrees(f[m][1]):.4f}, {f[m][2] * 1e6:.0f}"
                    for m in ("park", "shah") if m in f)  # fmt: skip
     return (f"{tag}  {v:<10}  {he(f['he0'])} -> {he(f['he'])}   {f['tcp0'][0] * 1e6:.0f} "
-            f"({f['tcp0'][1] * 1e6:.0f}) -> {f['tcp'][0] * 1e6:.1f} ({f['tcp'][1] * 1e6:.0f})   "
+            f"({f['tcp0'][1] * 1e6:.0f}) -> {f['tcp'][0] * 1e6:.1f} ({f['tcp'][1] * 1e6:.0f}; "
+            f"stated sigma {f['tcp_sigma'] * 1e6:.1f})   "
             f"{100 * f['within2']:.0f} % of {f['n_par']}  {f['solve_s']:.1f} s "
             f"({f['solve_cpu_s']:.1f} s CPU)   {cv}"
             + (f"  [dropped {', '.join(f['dropped'])}: a corner off the plate's plane]"

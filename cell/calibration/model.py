@@ -30,8 +30,8 @@ from robots.dh import DHTable
 Array = NDArray[np.float64]
 
 POSE_COLUMNS = ("x_m", "y_m", "z_m", "rx_rad", "ry_rad", "rz_rad")
-#: the intrinsic corrections of one camera (px), added to its ``K``
-INTRINSIC_COLUMNS = ("fx_px", "fy_px", "cx_px", "cy_px")
+#: the lens corrections of one camera: added to its ``K`` (px) and its distortion (OpenCV order)
+INTRINSIC_COLUMNS = ("fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "p1", "p2", "k3")
 N_INTRINSIC = len(INTRINSIC_COLUMNS)
 
 
@@ -73,7 +73,10 @@ def corrected(cam: Intrinsics, d: Array) -> Intrinsics:
     K[1, 1] += d[1]
     K[0, 2] += d[2]
     K[1, 2] += d[3]
-    return Intrinsics(K, cam.dist, cam.image_size)
+    dist = np.zeros(max(5, len(cam.dist)))
+    dist[: len(cam.dist)] = cam.dist
+    dist[:5] += d[4:9]
+    return Intrinsics(K, dist, cam.image_size)
 
 
 def _skew(v: Array) -> Array:
@@ -132,7 +135,7 @@ def _project(X: Array, cam: Intrinsics, jac: bool) -> tuple[Array, Array | None,
     px, J = cv2.projectPoints(X.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), cam.K, cam.dist)
     if not jac:
         return px.reshape(-1, 2), None, None
-    return px.reshape(-1, 2), J[:, 3:6].reshape(-1, 2, 3), J[:, 6:10]
+    return px.reshape(-1, 2), J[:, 3:6].reshape(-1, 2, 3), J[:, 6:15]
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,7 +204,7 @@ def predict(
     if stereo:
         sides.append(("right", obs.cameras.right))
     if state.intrinsics is not None:
-        sides = [(side, corrected(cam, state.intrinsics[4 * i : 4 * i + 4]))
+        sides = [(side, corrected(cam, state.intrinsics[N_INTRINSIC * i : N_INTRINSIC * (i + 1)]))
                  for i, (side, cam) in enumerate(sides)]  # fmt: skip
     for i_side, (side, cam) in enumerate(sides):
         corners, seen = obs.corners(side)
@@ -223,7 +226,7 @@ def predict(
             geo = np.einsum("nij,njk->nik", Jp, Ds.reshape(-1, 3, n_cols)).reshape(-1, n_cols)
             intr = np.zeros((len(geo), n_intr))
             if n_intr:
-                intr[:, 4 * i_side : 4 * i_side + 4] = Jk
+                intr[:, N_INTRINSIC * i_side : N_INTRINSIC * (i_side + 1)] = Jk
             rows_J.append(np.hstack([geo[:, : len(cols)], intr, geo[:, len(cols) :]]))
         views.append(np.repeat(np.flatnonzero(seen), M))
         cams.append(np.full(int(seen.sum()) * M, side))

@@ -82,11 +82,11 @@ class SolveOptions:
         max_dh_length_m, max_dh_angle_rad: largest plausible D-H length and angle error; a
             fit beyond says the joints belong to another arm (or another joint zero) than the
             nominal table, and is refused.
-        estimate_intrinsics: estimate corrections of each camera's fx, fy, cx, cy (px) with
-            the rest, as nuisance unknowns: the other estimates are then free of the stereo
-            calibration's intrinsic error and their covariance holds the intrinsics'
-            uncertainty (marginalised); the corrections are reported in the notes, not
-            written as estimates (the run measures with stereo.json).
+        estimate_intrinsics: estimate corrections of each camera's fx, fy, cx, cy (px) and
+            k1, k2, p1, p2, k3 (OpenCV distortion) with the rest, as nuisance unknowns: the
+            other estimates are then free of the stereo calibration's lens error and their
+            covariance holds the lens' uncertainty (marginalised); the corrections are
+            reported in the notes, not written as estimates (the run measures with stereo.json).
     """
 
     estimate_kinematics: bool = True
@@ -269,9 +269,15 @@ def solve_calibration(
     report, cr, intrinsics = _marginal_intrinsics(report, cr, state)
     cal = build_calibration(obs, dh, state, report, cr, pred, provenance or Provenance(), init)
     if intrinsics:
-        shown = ", ".join(f"{n[len('intrinsics.') :]} {v:+.2f}±{s:.2f}"
+        shown = ", ".join(f"{n[len('intrinsics.') :]} {v:+.3g}±{s:.2g}"
                           for n, (v, s) in intrinsics.items())  # fmt: skip
-        cal = replace(cal, notes=(*cal.notes, f"intrinsics corrected (px, marginalised): {shown}"))
+        cal = replace(
+            cal,
+            notes=(
+                *cal.notes,
+                f"intrinsics corrected (marginalised; fx..cy px, k, p: distortion): {shown}",
+            ),
+        )
     return CalibrationResult(
         status="calibrated",
         calibration=cal,

@@ -57,8 +57,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-kinematics", action="store_true", help="do not estimate D-H errors")
     p.add_argument(
         "--fixed-intrinsics", action="store_true",
-        help="take both cameras' fx, fy, cx, cy from the stereo calibration as exact (default: "
-        "estimate their corrections with the rest, marginalised; docs/calibration.md)",
+        help="take both cameras' lenses (fx, fy, cx, cy, distortion) from the stereo "
+        "calibration as exact (default: estimate their corrections with the rest, "
+        "marginalised; docs/calibration.md)",
     )  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)

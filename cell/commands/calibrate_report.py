@@ -60,10 +60,10 @@ def print_result(result: CalibrationResult) -> None:
     if free:
         print(f"D-H errors: {', '.join(dh_term_text(t.name, t.value, t.sigma) for t in free)}")
     if result.intrinsics:
-        shown = ", ".join(f"{n.removeprefix('intrinsics.')} {v:+.2f}±{e:.2f}"
+        shown = ", ".join(f"{n.removeprefix('intrinsics.')} {v:+.3g}±{e:.2g}"
                           for n, (v, e) in result.intrinsics.items())  # fmt: skip
         print(
-            f"intrinsic corrections (px, estimated with the rest; stereo.json unchanged): {shown}"
+            f"lens corrections (fx..cy px; k, p: OpenCV distortion; stereo.json unchanged): {shown}"
         )
     for name, reason in result.report.fixed.items():
         print(f"  fixed {name}: {reason}")

@@ -21,16 +21,38 @@ from cell.calibration.synthetic import (
     view_joints,
 )
 
-#: the true head's corrections (px): left fx, fy, cx, cy, right fx, fy, cx, cy
-TRUE_CORRECTION = np.array([3.0, -2.0, 1.5, -2.5, -2.0, 2.5, -1.0, 2.0])
+#: the true head's corrections: per camera fx, fy, cx, cy (px), k1, k2, p1, p2, k3
+TRUE_CORRECTION = np.array(
+    [
+        3.0,
+        -2.0,
+        1.5,
+        -2.5,
+        2e-3,
+        -1e-3,
+        0.0,
+        0.0,
+        0.0,
+        -2.0,
+        2.5,
+        -1.0,
+        2.0,
+        -1e-3,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ]
+)
+N = len(TRUE_CORRECTION) // 2
 
 
 def _data(seed: int, n_views: int = 16):
     tr = example_truth(seed)
     cams = tr.cameras
     true_cams = Cameras(
-        left=corrected(cams.left, TRUE_CORRECTION[:4]),
-        right=corrected(cams.right, TRUE_CORRECTION[4:]),
+        left=corrected(cams.left, TRUE_CORRECTION[:N]),
+        right=corrected(cams.right, TRUE_CORRECTION[N:]),
         T_left_right=cams.T_left_right,
         source="true head",
     )
@@ -51,7 +73,7 @@ def test_intrinsic_corrections_are_found_and_remove_the_bias(seed: int) -> None:
     est = solve_calibration(obs, tr.dh, SolveOptions(estimate_intrinsics=True))
     values = np.array([v for v, _s in est.intrinsics.values()])
     sigmas = np.array([s for _v, s in est.intrinsics.values()])
-    assert len(values) == 8 and np.all(sigmas > 0)
+    assert len(values) == 2 * N and np.all(sigmas > 0)
     assert np.all(np.abs(values - TRUE_CORRECTION) < 4 * sigmas + 0.05), (values, sigmas)
     dp_f, _ = pose_error(fixed.calibration.T_tool0_camera.T, truth.T_tool0_camera)
     dp_e, _ = pose_error(est.calibration.T_tool0_camera.T, truth.T_tool0_camera)
