@@ -1,6 +1,7 @@
 """The whole demo (calibration, then the frame) on seeded realistic truths, against the targets.
 
     .venv/bin/python benchmarks/demo_calibrated.py [--seeds 10] [--variant NAME ...]
+        [--method images|projected]
 
 Each row is one complete ``holecell demo`` (``cell.run.demo.run_demo``) on the truth
 ``CellTruth.drawn(seed)``: the cell calibrated first (the calibration's figures: hand-eye error
@@ -36,11 +37,12 @@ from cell.sim.truth import CellTruth
 VARIANTS = ("default", "no-calibration", "no-repeatability", "exact-head", "no-geometry")
 
 
-def options(seed: int, variant: str) -> DemoOptions:
-    """The demo's options of one seed and variant."""
+def options(seed: int, variant: str, method: str = "images") -> DemoOptions:
+    """The demo's options of one seed and variant; ``method``: the calibration's
+    (``"images"``: the demo's, plate rendered and detected; ``"projected"``: corners projected)."""
     cell = load_builtin_cell()
     truth = CellTruth.drawn(seed, cell)
-    opts = DemoOptions(seed=seed, truth=truth, calibration_method="projected")
+    opts = DemoOptions(seed=seed, truth=truth, calibration_method=method)
     if variant == "no-calibration":
         return replace(opts, calibrate=False)
     if variant == "no-repeatability":
@@ -56,11 +58,11 @@ def options(seed: int, variant: str) -> DemoOptions:
     return opts
 
 
-def one(seed: int, variant: str) -> dict:
+def one(seed: int, variant: str, method: str = "images") -> dict:
     """Run one demo; its figures (um, %, s)."""
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        res = run_demo(Path(tmp) / "run", options(seed, variant))
+        res = run_demo(Path(tmp) / "run", options(seed, variant, method))
         wall = time.perf_counter() - t0
     d, tr, c = res.datum, res.truth, res.calibration
     return {
@@ -89,6 +91,9 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--first", type=int, default=0, help="first seed")
     ap.add_argument("--variant", action="append", choices=VARIANTS, default=None)
+    ap.add_argument("--method", choices=("images", "projected"), default="images",
+                    help="the calibration's observations: images (the demo's) or projected "
+                    "corners (seconds a seed)")  # fmt: skip
     args = ap.parse_args()
     logging.getLogger("planner").setLevel(logging.ERROR)
     print("| seed | variant | hand-eye error | calibration s | datum frame RMS / max (um) | "
@@ -98,7 +103,7 @@ def main() -> None:
     rows = []
     for variant in args.variant or ["default"]:
         for seed in range(args.first, args.first + args.seeds):
-            rows.append(one(seed, variant))
+            rows.append(one(seed, variant, args.method))
             print(row(rows[-1]), flush=True)
     for variant in args.variant or ["default"]:
         rs = [r for r in rows if r["variant"] == variant]
