@@ -1,6 +1,6 @@
 """Validation errors of the cell file as ``(field path, value, message)`` problems, the form
-of :class:`cell.errors.ConfigError`. (``cell/sim/truth_file.py`` has its own copy, being
-reworked on another branch; to be made one with this after that lands.)"""
+of :class:`cell.errors.ConfigError`; the truth file (``cell/sim/truth_file.py``) names its
+fields with the same :func:`field_path`."""
 
 from __future__ import annotations
 

@@ -15,6 +15,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from cell.config import PART_TEMPERATURE_RANGE_C, Pose
+from cell.config_problems import field_path
 from cell.errors import NO_VALUE, TruthFileError
 from cell.yaml_problem import yaml_problem
 
@@ -107,16 +108,6 @@ class TruthSpec(_Strict):
     stereo: StereoTruth = StereoTruth()
 
 
-def _field_path(loc: tuple[Any, ...]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += f".{part}" if out else str(part)
-    return out or "(top level)"
-
-
 class _Short(str):
     """A long value's repr cut to :data:`MAX_VALUE_CHARS` (shown as is in a refusal)."""
 
@@ -137,7 +128,7 @@ def _problems(exc: ValidationError, prefix: tuple[Any, ...] = ()) -> list[tuple[
             msg = "unknown key"
         if err["type"] == "missing":  # pydantic's input is then the mapping around the key
             msg, err["input"] = "a required key is missing", NO_VALUE
-        out.append((_field_path((*prefix, *err["loc"])), _shown(err.get("input")), msg))
+        out.append((field_path((*prefix, *err["loc"])), _shown(err.get("input")), msg))
     return out
 
 
