@@ -4,6 +4,7 @@ fields with the same :func:`field_path`."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from pydantic import ValidationError
@@ -22,8 +23,14 @@ def field_path(loc: tuple[Any, ...]) -> str:
     return out or "(top level)"
 
 
-def pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
-    """Every error of ``exc`` as ``(field path, value, message)``; an unknown key says so."""
+def pydantic_problems(
+    exc: ValidationError,
+    prefix: tuple[Any, ...] = (),
+    shown: Callable[[object], object] = lambda value: value,
+) -> list[tuple[str, object, str]]:
+    """Every error of ``exc`` as ``(field path, value, message)``; an unknown key says so, a
+    missing one is named without the mapping around it. ``prefix``: the location of the
+    validated part in the file; ``shown``: how a value appears in the message."""
     problems = []
     for err in exc.errors():
         msg = err["msg"].removeprefix("Value error, ")
@@ -31,5 +38,5 @@ def pydantic_problems(exc: ValidationError) -> list[tuple[str, object, str]]:
             msg = "unknown key"
         if err["type"] == "missing":  # pydantic's input is then the mapping around the key
             msg, err["input"] = "a required key is missing", NO_VALUE
-        problems.append((field_path(err["loc"]), err.get("input"), msg))
+        problems.append((field_path((*prefix, *err["loc"])), shown(err.get("input")), msg))
     return problems

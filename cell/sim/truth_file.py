@@ -15,7 +15,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from cell.config import PART_TEMPERATURE_RANGE_C, Pose
-from cell.config_problems import field_path
+from cell.config_problems import pydantic_problems
 from cell.errors import NO_VALUE, TruthFileError
 from cell.yaml_problem import yaml_problem
 
@@ -121,15 +121,7 @@ def _shown(value: object) -> object:
 
 
 def _problems(exc: ValidationError, prefix: tuple[Any, ...] = ()) -> list[tuple[str, object, str]]:
-    out = []
-    for err in exc.errors():
-        msg = err["msg"].removeprefix("Value error, ")
-        if err["type"] == "extra_forbidden":
-            msg = "unknown key"
-        if err["type"] == "missing":  # pydantic's input is then the mapping around the key
-            msg, err["input"] = "a required key is missing", NO_VALUE
-        out.append((field_path((*prefix, *err["loc"])), _shown(err.get("input")), msg))
-    return out
+    return pydantic_problems(exc, prefix, _shown)
 
 
 def _dh_rows(data: dict[str, Any]) -> list[Any] | None:
