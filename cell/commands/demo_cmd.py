@@ -142,7 +142,7 @@ def format_demo(res: DemoResult) -> str:
         ("holes measured", f"{bar(measured, planned, 20)} {measured}/{planned}"),
         ("missing / unmeasurable", f"{s['holes_missing']} / {s['holes_unmeasured']}"),
         ("run-time flags", f"{s['holes_failed']} out of tol. / {s['holes_suspect']} suspect "
-                           "(fixture frame; the decisions below are the report's)"),
+                           "(a drawing's tolerances are decided in the report, below)"),
         ("decisions (ISO 14253-1)" if s.get("decision_rule") != "simple" else "decisions (simple)",
          f"{s['holes_conforming']} conformance proven / {s['holes_inconclusive']} inconclusive "
          f"/ {s['holes_nonconforming']} nonconformance proven"),
