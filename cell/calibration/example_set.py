@@ -34,10 +34,8 @@ from cell.calibration.observations import Cameras
 from cell.calibration.synthetic import (
     SyntheticTruth,
     example_truth,
-    reference_joints,
-    simulate,
+    seen_view_joints,
     truth_in_gauge,
-    view_joints,
 )
 from measure.calibration import StereoCalibration
 from measure.synth.heads import toed_in_stereo
@@ -83,20 +81,12 @@ class ExampleSet:
 
 def _seen_joints(truth: SyntheticTruth, n: int, seed: int, lower: Array, upper: Array) -> Array:
     """Joints (n, 6) of views showing every corner in every camera, within the limits."""
-    Q = view_joints(truth, 4 * n, STANDOFF_M, reference_joints(truth), seed=seed)
-    Q = Q[np.all((lower <= Q) & (upper >= Q), axis=1)]
-    obs = simulate(truth, Q, 0.0)
-    ok = [
-        i
-        for i, v in enumerate(obs.views)
-        if v.corners_left_px is not None
-        and (not truth.cameras.stereo or v.corners_right_px is not None)
-    ]
-    if len(ok) < n:
+    Q = seen_view_joints(truth, n, STANDOFF_M, seed, lower, upper)
+    if len(Q) < n:
         raise CalibrationDataError(
-            "--views", f"only {len(ok)} of {len(Q)} drawn views show the whole board; ask fewer"
+            "--views", f"only {len(Q)} of {4 * n} drawn views show the whole board; ask fewer"
         )
-    return Q[ok[:n]]
+    return Q
 
 
 def _true_head(truth: SyntheticTruth) -> StereoCalibration:

@@ -255,6 +255,31 @@ def reference_joints(truth: SyntheticTruth, standoff_m: float = 0.25) -> Array:
     return ik.solutions[np.argmin(np.linalg.norm(ik.solutions, axis=1))]
 
 
+def seen_view_joints(
+    truth: SyntheticTruth,
+    n: int,
+    standoff_m: tuple[float, float],
+    seed: int,
+    lower: Array | None = None,
+    upper: Array | None = None,
+) -> Array:
+    """Joints (at most n, 6) of views whose every corner falls inside every image: ``4 n``
+    views drawn by :func:`view_joints` about :func:`reference_joints`, those outside the joint
+    limits ``lower``/``upper`` (rad, if given) dropped, the first ``n`` that see the target
+    kept (the caller decides what too few means)."""
+    Q = view_joints(truth, 4 * n, standoff_m, reference_joints(truth), seed=seed)
+    if lower is not None and upper is not None:
+        Q = Q[np.all((lower <= Q) & (upper >= Q), axis=1)]
+    obs = simulate(truth, Q, 0.0)
+    ok = [
+        i
+        for i, v in enumerate(obs.views)
+        if v.corners_left_px is not None
+        and (not truth.cameras.stereo or v.corners_right_px is not None)
+    ]
+    return Q[ok[:n]]
+
+
 def truth_in_gauge(truth: SyntheticTruth) -> State:
     """The truth as the calibration can see it: the structurally redundant D-H terms folded
     into the target's and the camera's poses (``robots.calibration.redundancy.fold_redundant``)."""

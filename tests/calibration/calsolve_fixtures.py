@@ -12,9 +12,7 @@ from cell.calibration.observations import Cameras
 from cell.calibration.synthetic import (
     SyntheticTruth,
     example_truth,
-    reference_joints,
-    simulate,
-    view_joints,
+    seen_view_joints,
 )
 from measure.synth.heads import toed_in_stereo
 from measure.synth.targets import render_target_pair
@@ -39,18 +37,10 @@ def small_truth(seed: int = 0, stereo: bool = True, kinematic: bool = True) -> S
 
 def seen_views(truth: SyntheticTruth, n: int, seed: int, standoff=(0.2, 0.32)) -> np.ndarray:
     """Joints (n, 6) of views whose corners all fall inside every image."""
-    q0 = reference_joints(truth)
-    Q = view_joints(truth, 4 * n, standoff, q0, seed=seed)
-    obs = simulate(truth, Q, 0.0)
-    ok = [
-        i
-        for i, v in enumerate(obs.views)
-        if v.corners_left_px is not None
-        and (not truth.cameras.stereo or v.corners_right_px is not None)
-    ]
-    if len(ok) < n:
-        raise ValueError(f"only {len(ok)} of {4 * n} views see the target")
-    return Q[ok[:n]]
+    Q = seen_view_joints(truth, n, standoff, seed)
+    if len(Q) < n:
+        raise ValueError(f"only {len(Q)} of {4 * n} views see the target")
+    return Q
 
 
 def write_rendered_set(
