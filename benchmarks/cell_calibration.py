@@ -4,14 +4,14 @@ For each seed: the built-in cell with the drawn truth ``CellTruth.drawn(seed)`` 
 the head's mount, the base, the target's placement, the arm's repeatability, the head off its
 stereo calibration by a draw of its stated uncertainty), the calibration tour (planned once as
 ``holecell calibrate cell`` plans it, ``--views`` views, or ``--tour``) run on the simulated
-controller and head (``cell.calibration_run.capture``), then the adjustment, once per
+controller and head (``cell.calibration.capture.capture``), then the adjustment, once per
 ``--variant``: ``fixed`` takes the intrinsics from stereo.json as exact, ``intrinsics``
 estimates each camera's fx, fy, cx, cy with the rest (marginalised).
 
 Per seed and variant, before (the nominal cell) and after:
 
 - hand-eye error (mm, deg) against the truth in the calibration's gauge
-  (``cell.sim.calibration_truth``; targets <= 0.05 mm and <= 0.01 deg);
+  (``cell.demo.calibration_truth``; targets <= 0.05 mm and <= 0.01 deg);
 - TCP position error (RMS and worst, um) at 200 random joint poses looking into the part's
   volume (random points in the holes' bounding box, each viewed along a hole's normal at the
   standoff with a random roll, IK nearest that hole's tour configuration), the model's chain
@@ -39,19 +39,28 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.calibration.apply import CalibratedKinematics
-from cell.calibration.observations import Cameras
-from cell.calibration.solve import SolveOptions, pose_error, solve_calibration
-from cell.calibration.synthetic import parameter_errors
-from cell.calibration_run.capture import CaptureSettings, TourCapture
-from cell.calibration_run.orient import PLANE_TOLERANCE_PX, plane_outliers
-from cell.calibration_run.plan import calibrate_plan_options, plan_cell_calibration
-from cell.calibration_run.run import check_calibration_tour, observations_of
+from cell.calibration.capture import (
+    PLANE_TOLERANCE_PX,
+    CaptureSettings,
+    TourCapture,
+    check_calibration_tour,
+    observations_of,
+    plane_outliers,
+)
+from cell.calibration.estimate import (
+    Cameras,
+    SolveOptions,
+    parameter_errors,
+    pose_error,
+    solve_calibration,
+)
+from cell.calibration.plan import calibrate_plan_options, plan_cell_calibration
+from cell.calibration.use import CalibratedKinematics
+from cell.camera import cell_stereo
 from cell.config import load_builtin_cell
+from cell.config.tours import hole_stops
+from cell.demo.calibration_truth import tcp_errors_m, true_state
 from cell.link.client import ControllerClient
-from cell.run.camera import cell_stereo
-from cell.run.reference import hole_stops
-from cell.sim.calibration_truth import tcp_errors_m, true_state
 from cell.sim.session import SimCell
 from cell.sim.truth import CellTruth
 from cell.sim.world import WorldOptions
@@ -117,7 +126,7 @@ def capture_seed(cell, tour, seed: int, speed: float, cache: Path | None) -> dic
 
 
 def off_plane_views(cell, captures) -> list[str]:
-    """Views with a corner off the plate's plane (``cell.calibration_run.orient``): captures
+    """Views with a corner off the plate's plane (``cell.calibration.capture.orient``): captures
     cached before the capture repaired or refused them."""
     st, spec = cell_stereo(cell), cell.calibration_target.target_spec()
     out = []

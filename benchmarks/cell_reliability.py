@@ -25,13 +25,14 @@ from pathlib import Path
 
 import numpy as np
 
+from cell.camera import StereoPair
 from cell.config import builtin_cell_path, load_builtin_cell
+from cell.config.tours import stop_rows
 from cell.link.client import ControllerClient, LinkOptions
 from cell.link.messages import rad_to_wire
 from cell.review.recording import Recorder
 from cell.review.store import Store, count_measurements
-from cell.run.camera import StereoPair
-from cell.run.runner import Runner, RunOptions, stop_rows
+from cell.run.runner import Runner, RunOptions
 from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
@@ -94,10 +95,11 @@ def table(title: str, header: list[str], rows: list[list[object]]) -> None:
 def faulty_runs(cell, tour, root: Path, seeds: list[int], controller: str) -> None:
     rows = []
     for seed in seeds:
-        faults = FaultPlan(drop=0.05, corrupt=0.02, delay=0.02, disconnect_after=450,
-                           disconnect_s=2.0, seed=seed)  # fmt: skip
         # the interpreted module answers a full LOAD_ROWS frame in tens of ms
         link = LinkOptions(response_timeout_s=0.05 if controller == "python" else 0.15, retries=8)
+        faults = FaultPlan(drop=0.05, corrupt=0.02, delay=0.02, disconnect_after=450,
+                           disconnect_s=2.0, disconnect_frames=link.retries + 1,
+                           seed=seed)  # fmt: skip
         t0 = time.perf_counter()
         world = WorldOptions(speed=20.0, drift=STEADY, truth=CellTruth.zero(seed))
         with SimCell.start(cell, world, faults, controller=controller) as sim:

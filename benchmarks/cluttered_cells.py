@@ -27,7 +27,7 @@ import numpy as np
 import yaml
 
 from cell.config import HoleInCell, builtin_cell_path, parse_cell
-from cell.gdt.datums import without_drawing
+from cell.config.datums import without_drawing
 from planner.viewpoints import hole_candidates
 from robots.transforms import matrix_to_rpy
 

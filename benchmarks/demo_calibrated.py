@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/demo_calibrated.py [--seeds 10] [--variant NAME ...]
         [--method images|projected]
 
-Each row is one complete ``holecell demo`` (``cell.run.demo.run_demo``) on the truth
+Each row is one complete ``holecell demo`` (``cell.demo.demo.run_demo``) on the truth
 ``CellTruth.drawn(seed)``: the cell calibrated first (the calibration's figures: hand-eye error
 against the truth, wall time), then the 41 holes measured with it. Columns: hole position
 error against the truth in the hole plane, in the datum frame A|B|C (the drawing's: what the
@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from cell.config import load_builtin_cell
-from cell.run.demo import DemoOptions, run_demo
+from cell.demo.demo import DemoOptions, run_demo
 from cell.sim.truth import CellTruth
 
 VARIANTS = ("default", "no-calibration", "no-repeatability", "exact-head", "no-geometry")

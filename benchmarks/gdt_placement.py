@@ -30,8 +30,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from cell.config import load_builtin_cell
+from cell.demo.demo import DemoOptions, demo_truth, demo_world, run_demo
 from cell.gdt.truth_check import coverage, placement_error, true_evaluation
-from cell.run.demo import DemoOptions, demo_truth, demo_world, run_demo
 from cell.sim.world import SimWorld
 from robots.transforms import invert
 

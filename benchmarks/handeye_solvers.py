@@ -1,9 +1,9 @@
 """Hand-eye solvers on simulated data with a known truth: our adjustment against plain OpenCV.
 
-For each seed, a truth is drawn (:func:`cell.calibration.synthetic.example_truth`: the standard
-toed-in head on an ABB IRB 1600, D-H errors of 0.3 mm and 0.02 deg, the head 1 mm and 0.3 deg
-off its drawing) and ``--views`` views of the target are simulated with ``--noise`` px of corner
-noise. Two scenarios:
+For each seed, a truth is drawn (:func:`cell.calibration.estimate.synthetic.example_truth`:
+the standard toed-in head on an ABB IRB 1600, D-H errors of 0.3 mm and 0.02 deg, the head 1 mm and
+0.3 deg off its drawing) and ``--views`` views of the target are simulated with ``--noise`` px of
+corner noise. Two scenarios:
 
 - ``exact flange``: the arm has no D-H errors, every method gets the true flange poses (the
   adjustment too: no kinematic terms);
@@ -29,14 +29,16 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cell.calibration.initial import hand_eye_candidates, solve_pnp
-from cell.calibration.model import flange_poses
-from cell.calibration.solve import pose_error, solve_calibration
-from cell.calibration.synthetic import (
+from cell.calibration.estimate import (
     example_truth,
+    flange_poses,
+    hand_eye_candidates,
     parameter_errors,
+    pose_error,
     reference_joints,
     simulate,
+    solve_calibration,
+    solve_pnp,
     truth_in_gauge,
     view_joints,
 )

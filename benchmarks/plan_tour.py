@@ -34,7 +34,7 @@ import yaml
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
 from cell.config import CellConfig, builtin_cell_path, parse_cell
-from cell.gdt.datums import without_drawing
+from cell.config.datums import without_drawing
 from planner import Options, TourPlanner
 from planner.costs import travel_time
 from planner.sequence import SequenceResult, layered_best, tour_cost

@@ -24,7 +24,7 @@ import time
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cell.run.camera import NetworkCamera, StereoPair
+from cell.camera import NetworkCamera, StereoPair
 from cell.sim.camserver import CameraServer
 from measure.synth import targets as fast
 from measure.synth.heads import standard_stereo

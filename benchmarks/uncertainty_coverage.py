@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.run.demo import DemoOptions, run_demo
+from cell.demo.demo import DemoOptions, run_demo
 
 
 def demo_options(seed: int) -> DemoOptions:
@@ -73,8 +73,8 @@ def gdt_coverage(run_dir: Path, seed: int):
     import json
 
     from cell.config import load_builtin_cell
+    from cell.demo.demo import demo_world
     from cell.gdt.truth_check import coverage, true_evaluation
-    from cell.run.demo import demo_world
     from cell.sim.world import SimWorld
     from robots.transforms import invert
 

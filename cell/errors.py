@@ -27,3 +27,14 @@ class ConfigError(CellError):
 
 class TruthFileError(ConfigError):
     """A simulated-truth file (``truth.yaml``) is invalid; same payload as :class:`ConfigError`."""
+
+
+class TourMismatchError(CellError):
+    """A tour does not belong to the cell (or robot) it is run with."""
+
+    def __init__(self, tour: str, field: str, tour_value: object, cell_value: object) -> None:
+        self.tour, self.field = tour, field
+        super().__init__(
+            f"{tour}: {field} is {tour_value!r} but the cell has {cell_value!r}: "
+            "plan the tour for this cell (holecell plan CELL -o tour.json)"
+        )

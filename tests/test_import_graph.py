@@ -134,7 +134,7 @@ def test_cycle_finder_finds_a_known_circle() -> None:
 
 
 def test_relative_and_from_imports_resolve(tmp_path: Path) -> None:
-    modules = {"cell": ROOT / "cell/__init__.py", "cell.config": ROOT / "cell/config.py"}
+    modules = {"cell": ROOT / "cell/__init__.py", "cell.config": ROOT / "cell/config/load.py"}
     source = tmp_path / "x.py"
     source.write_text("def f():\n    from . import config\n    from .config import Thing\n")
     assert imports_of("cell.x", source, modules) == {"cell.config"}

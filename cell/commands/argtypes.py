@@ -94,7 +94,7 @@ def output_file(text: str) -> Path:
 
 def hole_diameter_m(text: str) -> float:
     """A hole diameter (m): positive, and not so large that it must be millimetres."""
-    from cell.gdt.plausible import MAX_DIAMETER_M
+    from cell.config.plausible import MAX_DIAMETER_M
 
     value = positive_float(text)
     if value > MAX_DIAMETER_M:

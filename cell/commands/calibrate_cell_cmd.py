@@ -89,17 +89,21 @@ def run(args: argparse.Namespace) -> int:
     """Handler: plan (or read) the tour, connect, run, solve, report, write."""
     from dataclasses import replace
 
+    from cell.calibration.capture import (
+        CalibrateCellOptions,
+        CaptureSettings,
+        check_calibration_tour,
+        run_calibration_tour,
+    )
     from cell.calibration.errors import CalibrationDataError
-    from cell.calibration.modelfile import save_calibration
-    from cell.calibration.solve import SolveOptions
-    from cell.calibration_run import CalibrateCellOptions, CaptureSettings, run_calibration_tour
-    from cell.calibration_run.plan import calibrate_plan_options, plan_cell_calibration
-    from cell.calibration_run.run import check_calibration_tour
+    from cell.calibration.estimate import SolveOptions
+    from cell.calibration.file import save_calibration
+    from cell.calibration.plan import calibrate_plan_options, plan_cell_calibration
+    from cell.camera import NetworkCamera, cell_stereo
     from cell.commands.calibrate_report import print_result
     from cell.config import load_cell
     from cell.errors import CellError
     from cell.link.client import ControllerClient
-    from cell.run.camera import NetworkCamera, cell_stereo
     from planner.calibration import load_caltour
 
     out = Path(args.output)

@@ -35,7 +35,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Handler: write the set, print what was written and the command to run."""
-    from cell.calibration.example_set import write_example_set
+    from cell.calibration.inputs import write_example_set
 
     s = write_example_set(
         args.folder, args.views, args.seed, stereo=not args.mono, joints=not args.flange

@@ -88,13 +88,9 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from cell.calibration.errors import CalibrationDataError
-    from cell.calibration.images import observations_from_images
-    from cell.calibration.intrinsics import read_intrinsics
-    from cell.calibration.modelfile import save_calibration
-    from cell.calibration.observations import Cameras
-    from cell.calibration.posecsv import read_pose_csv
-    from cell.calibration.provenance import cell_provenance
-    from cell.calibration.solve import SolveOptions, solve_calibration
+    from cell.calibration.estimate import Cameras, SolveOptions, solve_calibration
+    from cell.calibration.file import cell_provenance, save_calibration
+    from cell.calibration.inputs import observations_from_images, read_intrinsics, read_pose_csv
     from cell.commands.calibrate_report import print_result
     from cell.config import load_cell
     from measure.calibration import StereoCalibration

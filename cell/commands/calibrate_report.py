@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cell.calibration.result import PoseEstimate
-from cell.calibration.solve import CalibrationResult, pose_error
+from cell.calibration.estimate import CalibrationResult, PoseEstimate, pose_error
 
 
 def _pose_line(name: str, p: PoseEstimate) -> str:

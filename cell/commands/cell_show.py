@@ -10,7 +10,7 @@ import numpy as np
 from cell.commands.group_help import help_handler
 from cell.config import CellConfig, load_cell
 from cell.errors import CellError
-from cell.reach import hole_reach
+from planner.reach import hole_reach
 from robots import Arm
 
 

@@ -10,8 +10,8 @@ import numpy as np
 
 from cell.commands.argtypes import part_temperature_c
 from cell.commands.run_progress import RunBars, bar
+from cell.demo.demo import DemoOptions, DemoResult, run_demo
 from cell.errors import CellError
-from cell.run.demo import DemoOptions, DemoResult, run_demo
 from cell.uncertainty.decision import DECISION_RULES, DEFAULT_RULE
 
 

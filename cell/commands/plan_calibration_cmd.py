@@ -1,7 +1,7 @@
 """``holecell plan-calibration [CELL] -o caltour.json``: plan the calibration tour of a cell.
 
 Chooses ``--views`` views of the cell's ``calibration_target`` by experimental design
-(:mod:`cell.calibration_plan.plan`), orders and times them with the hole tour's machinery and
+(:mod:`cell.calibration.plan.plan`), orders and times them with the hole tour's machinery and
 writes ``caltour.json`` (``planner.calibration.tour``); prints the robot time, the planning time,
 the design's geometric figures and the predicted σ of the calibration parameters.
 """
@@ -14,15 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.calibration_plan.plan import CRITERIA, CalibrationPlanOptions, plan_calibration
-from cell.calibration_plan.target import cell_target
+from cell.calibration.plan import CRITERIA, CalibrationPlanOptions, cell_target, plan_calibration
+from cell.camera import cell_stereo
 from cell.commands.argtypes import non_negative_float, positive_int
 from cell.commands.plan_cmd import StageBars
 from cell.config import CellConfig, load_cell
+from cell.config.tours import check_tour, hole_stops
 from cell.errors import CellError
-from cell.run.camera import cell_stereo
-from cell.run.reference import hole_stops
-from cell.run.setup import check_tour
 from planner import Options, load_tour
 from planner.calibration import CalibrationTour
 

@@ -7,6 +7,15 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from cell.calibration.use import (
+    MAX_AGE_DAYS,
+    RunCalibration,
+    RunGeometry,
+    load_run_calibration,
+    store_calibration,
+    stored_calibration_path,
+)
+from cell.camera import NetworkCamera, cell_stereo
 from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
@@ -15,23 +24,15 @@ from cell.commands.argtypes import (
 )
 from cell.commands.run_progress import RunBars
 from cell.config import CellConfig, load_cell
+from cell.config.tours import check_tour
 from cell.errors import CellError
 from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.review.recording import Recorder
 from cell.review.report import format_summary, write_report
-from cell.run.calibration import (
-    MAX_AGE_DAYS,
-    RunCalibration,
-    RunGeometry,
-    load_run_calibration,
-    store_calibration,
-    stored_calibration_path,
-)
-from cell.run.camera import NetworkCamera, cell_stereo
 from cell.run.reference import plan_reference_tour
 from cell.run.runner import Runner, RunOptions
-from cell.run.setup import RunFiles, check_new_run_dir, check_tour, resume_run, start_run
+from cell.run.setup import RunFiles, check_new_run_dir, resume_run, start_run
 from cell.run.thermal_check import check_model_for_cell, check_model_sensors
 from cell.uncertainty.decision import DECISION_RULES, DEFAULT_RULE
 from planner import load_tour

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 from typing import TextIO
 
-from cell.run.results import HoleResult
+from cell.records.hole_result import HoleResult
 
 WIDTH = 30
 

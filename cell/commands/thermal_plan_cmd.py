@@ -24,9 +24,9 @@ import numpy as np
 
 from cell.commands.argtypes import non_negative_int, output_file, positive_float
 from cell.config import CellConfig, ReferenceTarget, load_cell
+from cell.config.tours import check_tour, hole_stops
 from cell.errors import CellError
-from cell.run.reference import design_reference_plan, fixed_reference_plan, hole_stops
-from cell.run.setup import check_tour
+from cell.run.reference import design_reference_plan, fixed_reference_plan
 from cell.run.target_suggest import suggest_targets
 from planner import load_tour
 from robots.thermal.design import Design, DesignOptions, evaluate

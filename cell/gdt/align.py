@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
-from cell.gdt.datums import Datum
+from cell.config.datums import Datum
 from cell.gdt.errors import GdtError
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}

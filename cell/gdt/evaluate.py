@@ -20,8 +20,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from cell.config import CellConfig, Hole
+from cell.config.datums import Datum
 from cell.gdt.align import Frames, best_fit_frame, datum_frame
-from cell.gdt.datums import Datum
 from cell.gdt.decide import (
     NOT_EVALUATED,
     decide_interval,
@@ -29,7 +29,7 @@ from cell.gdt.decide import (
 )
 from cell.gdt.errors import GdtError
 from cell.gdt.montecarlo import McOptions, draw_centres, expanded
-from cell.run.results import HoleResult
+from cell.records.hole_result import HoleResult
 from cell.uncertainty.decision import DEFAULT_RULE
 
 FIXTURE = "fixture"

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from cell.run.results import HoleResult
+from cell.records.hole_result import HoleResult
 
 
 @dataclass(frozen=True)

@@ -20,11 +20,12 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
-from cell.config import CellConfig, _with_csv_holes
+from cell.config import CellConfig
+from cell.config.load import _with_csv_holes
 from cell.errors import ConfigError
 from cell.gdt.decide import CONFORMANCE, INDETERMINATE, NONCONFORMANCE, NOT_EVALUATED, hole_decision
 from cell.gdt.evaluate import FIXTURE, Evaluation, evaluate
-from cell.run.results import HoleResult
+from cell.records.hole_result import HoleResult
 from cell.uncertainty.decision import CONFORMING, INCONCLUSIVE, NONCONFORMING
 
 CHARACTERISTIC_DECISIONS = (CONFORMANCE, INDETERMINATE, NONCONFORMANCE, NOT_EVALUATED)

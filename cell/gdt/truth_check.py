@@ -19,7 +19,7 @@ from scipy.spatial.transform import Rotation
 from cell.config import CellConfig
 from cell.gdt.evaluate import Evaluation, evaluate
 from cell.gdt.montecarlo import McOptions
-from cell.run.results import HoleResult
+from cell.records.hole_result import HoleResult
 
 
 @dataclass

@@ -42,3 +42,14 @@ class MoveTimeoutError(CellError):
         super().__init__(
             f"controller {url}: stop {stop} not reached within {timeout_s:.1f} s (state {state})"
         )
+
+
+class RunFaultError(CellError):
+    """The run stopped on a controller fault; ``state`` and ``fault`` as the controller said."""
+
+    def __init__(self, where: str, state: str, fault: str) -> None:
+        self.where, self.state, self.fault = where, state, fault
+        super().__init__(
+            f"run stopped at {where}: controller {state} ({fault}); every hole measured so far "
+            "is stored; clear the fault, then continue with --resume RUN_DIR"
+        )

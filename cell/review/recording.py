@@ -32,7 +32,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from cell.config import CellConfig
-from cell.run.results import HoleResult
+from cell.records.hole_result import HoleResult
 from planner import Tour
 from robots import Shape
 

@@ -20,13 +20,13 @@ import json
 from pathlib import Path
 from typing import Any
 
-from cell.gdt.html import gdt_section
+from cell.calibration.use import calibration_summary
 from cell.gdt.report_fields import report_evaluation
+from cell.records.hole_result import HoleResult
+from cell.review.gdt_html import gdt_section
 from cell.review.qif.run_file import write_run_qif
 from cell.review.report_html import render_html
 from cell.review.store import Store
-from cell.run.calibration import calibration_summary
-from cell.run.results import HoleResult
 from cell.uncertainty.budget import COMPONENTS
 from cell.uncertainty.decision import CONFORMING, INCONCLUSIVE, NONCONFORMING
 

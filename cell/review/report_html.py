@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
+from cell.calibration.use import describe
+from cell.records.hole_result import HoleResult
 from cell.review.svg import COLORS, SERIES, Axes, frame, line, svg, text, ticks
-from cell.run.calibration import describe
-from cell.run.results import HoleResult
 from cell.uncertainty.budget import COMPONENTS
 
 DECISION_LABEL = {"conforming": "conformance proven", "inconclusive": "inconclusive",
@@ -252,7 +252,7 @@ def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleRe
                 gdt_html: str = "", fixture_plot: bool = True) -> str:  # fmt: skip
     """The whole ``report.html`` document; ``reference``: (controller time s, readings degC)
     of the reference-target observations, for the thermal plot; ``gdt_html``: the alignment
-    and characteristics (:mod:`cell.gdt.html`), after the counts; ``fixture_plot``: draw the
+    and characteristics (:mod:`cell.review.gdt_html`), after the counts; ``fixture_plot``: draw the
     deviation vectors in the part frame (False when the run is evaluated in a datum frame,
     whose own plot ``gdt_html`` holds)."""
     parts = [

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from cell.records.hole_result import HoleResult
 from cell.review.store_file import (
     FILENAME,
     READABLE_VERSIONS,
@@ -40,7 +41,6 @@ from cell.review.store_file import (
     create_file,
     upgrade,
 )
-from cell.run.results import HoleResult
 
 __all__ = [
     "FILENAME",

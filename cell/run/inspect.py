@@ -1,5 +1,5 @@
-"""One capture into one :class:`cell.run.results.HoleResult`: measure, carry into the part frame
-through the (compensated) kinematics, compare with the nominal.
+"""One capture into one :class:`cell.records.hole_result.HoleResult`: measure, carry into the part
+frame through the (compensated) kinematics, compare with the nominal.
 
 Frames: the measurement comes in the LEFT camera optical frame; ``T_head_left`` (the inverse of
 :func:`measure.head_frame`) carries it into the head frame, which is the TCP;
@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
+from cell.calibration.use import RunGeometry
 from cell.config import CellConfig, HoleInCell
 from cell.gdt.montecarlo import gdt_extra
-from cell.run.calibration import RunGeometry
-from cell.run.results import HoleResult, deviations
+from cell.records.hole_result import HoleResult, deviations
 from cell.uncertainty.budget import combine
 from cell.uncertainty.context import BudgetContext, budget_context, hole_contributions
 from cell.uncertainty.decision import decide_hole, decide_one

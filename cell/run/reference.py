@@ -18,11 +18,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.config import CellConfig, Hole
+from cell.config.tours import hole_stops
 from cell.errors import CellError
 from planner import Options, Tour, TourPlanner
 from planner.protocols import ArmLike, CellLike
 from planner.tour import LeftOut
-from planner.viewpoints import HoleCandidates, hole_candidates
+from planner.viewpoints import HoleCandidates
 from robots.thermal.design import Design, DesignOptions, candidate_views, design_views
 from robots.thermal.errors import ThermalError
 from robots.thermal.plan import view_plan
@@ -37,26 +38,6 @@ log = logging.getLogger(__name__)
 def target_of(stop_id: str) -> str:
     """The reference target id of a reference-tour stop id (``"R1#2"`` -> ``"R1"``)."""
     return stop_id.split(VIEW_SEPARATOR, 1)[0]
-
-
-def hole_stops(
-    cell: CellConfig, roll_step_deg: float = 15.0
-) -> tuple[list[str], NDArray[np.float64]]:
-    """Stand-in stops when no tour is given: hole ids and (S, 6) rad, per hole its
-    collision-free viewpoint configuration nearest home (the planner's candidates). Holes the
-    arm cannot see are left out."""
-    arm, home = cell.build_arm(), cell.home_q()
-    ids, out = [], []
-    for hole in cell.holes_in_cell():
-        c = hole_candidates(arm, hole, cell.tool.standoff_m, roll_step_deg)
-        if c.ok:
-            ids.append(hole.id)
-            out.append(c.q[np.argmin(np.abs(c.q - home).sum(axis=1))])
-    if not out:
-        raise CellError(
-            f"cell {cell.name!r}: no hole is reachable to design the reference plan for"
-        )
-    return ids, np.array(out)
 
 
 def design_reference_plan(

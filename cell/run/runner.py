@@ -19,18 +19,17 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from cell.calibration.use import RunCalibration, RunGeometry, calibrated_stereo, correct_tour
+from cell.camera import CameraBackend
 from cell.config import CellConfig
 from cell.errors import CellError
 from cell.link.client import ControllerClient
-from cell.link.errors import LinkError
+from cell.link.errors import LinkError, RunFaultError
+from cell.link.motion import Motion
+from cell.records.hole_result import HoleResult
 from cell.review.store import Store
-from cell.run.calibration import RunCalibration, RunGeometry, calibrated_stereo
-from cell.run.camera import CameraBackend
-from cell.run.corrected_tour import correct_tour
 from cell.run.inspect import T_cell_tcp, inspect_hole
-from cell.run.motion import Motion, RunFaultError, stop_rows  # noqa: F401 (re-exported)
 from cell.run.reference import target_of
-from cell.run.results import HoleResult
 from cell.run.thermal_record import remember_model, stored_model, stored_rows
 from cell.run.thermal_update import ThermalUpdate
 from cell.uncertainty.context import BudgetContext, budget_context

@@ -12,58 +12,13 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from cell.config import CellConfig, parse_cell
+from cell.config.tours import check_tour
 from cell.errors import CellError
 from cell.review.store import FILENAME, Store
-from cell.run.runner import stop_rows
-from planner import Tour, TourCellMismatchError, check_tour_for_cell
+from planner import Tour
 from planner.planner import cell_sha256
 from planner.tour import tour_from_dict
-from robots.models import JOINT_NAMES, MODELS
-
-
-class TourMismatchError(CellError):
-    """A tour does not belong to the cell (or robot) it is run with."""
-
-    def __init__(self, tour: str, field: str, tour_value: object, cell_value: object) -> None:
-        self.tour, self.field = tour, field
-        super().__init__(
-            f"{tour}: {field} is {tour_value!r} but the cell has {cell_value!r}: "
-            "plan the tour for this cell (holecell plan CELL -o tour.json)"
-        )
-
-
-def check_tour(tour: Tour, cell: CellConfig, where: str, reference: bool = False) -> None:
-    """Refuse a tour not made for ``cell`` (:func:`planner.check_tour_for_cell`: robot model, cell
-    name, SHA-256 of the cell file text; here also joint names, trajectory shape, stops on the
-    trajectory, known holes, no hole visited twice). Reference tours are checked for the robot
-    only."""
-    if reference:
-        if tour.robot_model != cell.robot.model:
-            raise TourMismatchError(where, "robot model", tour.robot_model, cell.robot.model)
-    else:
-        try:
-            check_tour_for_cell(tour, cell)
-        except TourCellMismatchError as exc:
-            raise TourMismatchError(where, exc.field, exc.tour_value, exc.cell_value) from exc
-    names = JOINT_NAMES if cell.robot.model in MODELS else cell.build_robot().joint_names
-    if tuple(tour.joint_names) != tuple(names):
-        raise TourMismatchError(where, "robot.joint_names", tour.joint_names, names)
-    traj = np.asarray(tour.trajectory)
-    if traj.ndim != 2 or traj.shape[1] != 6 or len(traj) < 2:
-        raise CellError(f"{where}: trajectory has shape {traj.shape}, expected (N >= 2, 6)")
-    ids = [s.hole_id for s in tour.stops]
-    repeated = sorted({h for h in ids if ids.count(h) > 1})
-    if repeated:
-        raise CellError(f"{where}: stops[].hole_id: holes visited more than once: {repeated[:5]}")
-    if not reference:
-        known = {h.id for h in cell.part.holes}
-        unknown = [s.hole_id for s in tour.stops if s.hole_id not in known]
-        if unknown:
-            raise CellError(f"{where}: stops.hole_id: holes the cell does not have: {unknown[:5]}")
-    stop_rows(tour)
 
 
 def check_new_run_dir(out: str | Path, resumable: bool = True) -> None:

@@ -5,5 +5,5 @@ hidden truth it moves (thermal drift, true hole geometry) and a simulated stereo
 - :mod:`cell.sim.world`: the truth: sim clock, drifted kinematics, true holes.
 - :mod:`cell.sim.faults`: what to inject (dropped, corrupted, delayed frames, disconnect, e-stop).
 - :mod:`cell.sim.server`: the controller served over a pseudo-terminal or a local socket.
-- :mod:`cell.sim.camera`: the simulated stereo head behind :class:`cell.run.camera.CameraBackend`.
+- :mod:`cell.sim.camera`: the simulated stereo head behind :class:`cell.camera.CameraBackend`.
 """

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cell.run.camera import StereoPair
+from cell.camera import StereoPair
 from cell.sim.controller import SimController
 from cell.sim.world import SimWorld, TrueHole
 from cell.uncertainty.calibration import (
@@ -60,7 +60,7 @@ class CaptureTruth:
 
 
 class SimCamera:
-    """A :class:`cell.run.camera.CameraBackend` rendering from a :class:`SimWorld`."""
+    """A :class:`cell.camera.CameraBackend` rendering from a :class:`SimWorld`."""
 
     def __init__(
         self,

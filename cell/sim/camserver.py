@@ -1,7 +1,7 @@
 """The simulated head served over TCP, for a runner in another process (:class:`NetworkCamera`).
 
 One client at a time; each ``CAPTURE`` line is answered by a JSON header line and the two raw
-images (see :class:`cell.run.camera.NetworkCamera`).
+images (see :class:`cell.camera.NetworkCamera`).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import logging
 import socket
 import threading
 
-from cell.run.camera import CameraError
+from cell.camera import CameraError
 from cell.sim.camera import SimCamera
 
 log = logging.getLogger(__name__)

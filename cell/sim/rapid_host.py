@@ -161,16 +161,18 @@ class SimSocket:
         while True:
             self.host.poll()
             left = end - time.monotonic()
-            if not self.host.wire.dead() and select.select([self.sock], [], [], max(0.0, min(
-                    left, 0.002)))[0]:  # fmt: skip
+            wait_s = max(0.0, min(left, 0.002))
+            alive = not self.host.wire.outage.timed_out()
+            if alive and select.select([self.sock], [], [], wait_s)[0]:
                 conn, _ = self.sock.accept()
                 conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
                 conn.setblocking(False)
                 self.host.wire.cut = False
+                self.host.wire.outage.reconnected()
                 return SimSocket(self.host, conn)
             if left <= 0:
                 raise RapidRunError("ERR_SOCK_TIMEOUT", f"no connection within {timeout_s} s")
-            if self.host.wire.dead():
+            if self.host.wire.outage.timed_out():
                 time.sleep(min(left, 0.002))
 
     def connect(self, address: str, port: int, timeout_s: float) -> None:

@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from cell.link import frame as fr
-from cell.sim.faults import FaultPlan
+from cell.sim.faults import FaultPlan, Outage
 
 
 class WireFaults:
@@ -28,15 +28,15 @@ class WireFaults:
         self._out: list[tuple[float, int, bytes]] = []
         self._n_out = 0
         self.requests = self.dropped = self.corrupted = self.disconnects = 0
-        self.dead_until = 0.0
+        self.outage = Outage(plan)
         self.cut = False
 
     def dead(self) -> bool:
-        return time.monotonic() < self.dead_until
+        return self.outage.dead()
 
     def inbound(self, data: bytes) -> bytes:
         """What of a received chunk reaches the controller."""
-        if not data or self.dead():
+        if not data or self.outage.swallow(data):
             return b""
         if self._rng.random() < self.plan.drop:
             self.dropped += 1
@@ -48,7 +48,7 @@ class WireFaults:
             self.requests += 1
             if self.requests == self.plan.disconnect_after:
                 self.disconnects += 1
-                self.dead_until = time.monotonic() + self.plan.disconnect_s
+                self.outage.start()
                 self._out.clear()
                 self._decoder = fr.FrameDecoder()
                 self.cut = True

@@ -22,7 +22,7 @@ import numpy as np
 from cell.link import frame as fr
 from cell.link import messages as m
 from cell.sim.controller import SimController
-from cell.sim.faults import FaultPlan
+from cell.sim.faults import FaultPlan, Outage
 
 log = logging.getLogger(__name__)
 
@@ -51,7 +51,7 @@ class SimServer:
         self.dropped = 0
         self.corrupted = 0
         self.disconnects = 0
-        self._dead_until = 0.0
+        self._outage = Outage(self.faults)
         self._listener: socket.socket | None = None
         self._conn: socket.socket | None = None
         self._closed = False
@@ -125,7 +125,7 @@ class SimServer:
         return self._conn.fileno() if self._conn is not None else None
 
     def _accept(self) -> None:
-        if time.monotonic() < self._dead_until or self._listener is None:
+        if self._outage.timed_out() or self._listener is None:
             return
         try:
             conn, _ = self._listener.accept()
@@ -133,6 +133,7 @@ class SimServer:
             return
         conn.setblocking(False)
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._outage.reconnected()
         self._conn = conn
 
     def _read(self, fd: int) -> bytes:
@@ -156,7 +157,7 @@ class SimServer:
 
     def _receive(self, fd: int) -> None:
         data = self._read(fd)
-        if not data or time.monotonic() < self._dead_until:
+        if not data or self._outage.swallow(data):
             return
         if self._rng.random() < self.faults.drop:
             self.dropped += 1
@@ -178,7 +179,7 @@ class SimServer:
     def _disconnect(self) -> None:
         log.info("simulated disconnect for %.2f s", self.faults.disconnect_s)
         self.disconnects += 1
-        self._dead_until = time.monotonic() + self.faults.disconnect_s
+        self._outage.start()
         self._out.clear()
         if self.transport == "socket":
             self._drop_connection()

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from cell.camera import cell_stereo
 from cell.config import CellConfig
-from cell.run.camera import cell_stereo
 from cell.sim.camera import SimCamera
 from cell.sim.controller import SimController
 from cell.sim.faults import FaultPlan

@@ -15,9 +15,9 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from cell.config import PART_TEMPERATURE_RANGE_C, Pose
-from cell.config_problems import pydantic_problems
+from cell.config.problems import pydantic_problems
+from cell.config.yaml_problem import yaml_problem
 from cell.errors import NO_VALUE, TruthFileError
-from cell.yaml_problem import yaml_problem
 
 #: the truth file's format tag (optional in a file; written first)
 FORMAT = "holecell.truth/1"

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cell.run.camera import cell_stereo
+from cell.camera import cell_stereo
 from cell.sim.true_geometry import TrueGeometry
 from cell.sim.truth import CellTruth
 from measure import StereoCalibration, head_frame

@@ -19,8 +19,8 @@ Components (names as stored): ``circle_fit`` (the fit's covariance), ``stereo_ca
 ``robot_repeatability`` (:mod:`cell.uncertainty.repeatability`), ``part_temperature``
 (:mod:`cell.uncertainty.part_temperature`), ``cell_calibration`` (a run with ``--calibration``:
 the hand-eye and D-H terms' joint covariance carried to the hole's centre, first order,
-:meth:`cell.run.calibration.RunGeometry.point_covariance_cell`; without one the cell file's
-kinematics, base and head mount are taken as exact and the row is absent), and
+:meth:`cell.calibration.use.run_calibration.RunGeometry.point_covariance_cell`; without one the
+cell file's kinematics, base and head mount are taken as exact and the row is absent), and
 ``nonlinearity`` (the second-order term).
 """
 

@@ -21,7 +21,7 @@ it): for points on a circle it has the sensitivity of the orthogonal fit, at a f
 cost. The left camera's pose relative to the TCP is the hand-eye calibration's: this component
 moves points within the left camera frame only; the hand-eye's (and the arm's D-H terms')
 uncertainty is the budget's ``cell_calibration`` component when the run applies a cell
-calibration (:mod:`cell.run.calibration`).
+calibration (:mod:`cell.calibration.use.run_calibration`).
 
 A calibration without an uncertainty block gets :func:`default_uncertainty` (figures of a
 careful calibration with a certified target, scaled to the head's focal length and baseline),

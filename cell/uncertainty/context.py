@@ -79,7 +79,8 @@ def hole_contributions(
     """The contributions of one measured hole (see :mod:`cell.uncertainty.budget`): five, and
     ``cell_calibration`` when the run applies a cell calibration (``cell_calibration_cov_m2``:
     the centre's covariance in the part frame, m^2, from the calibration's covariance:
-    :meth:`cell.run.calibration.RunGeometry.point_covariance_cell` rotated into the part)."""
+    :meth:`cell.calibration.use.run_calibration.RunGeometry.point_covariance_cell` rotated into the
+    part)."""
     cov = np.asarray(meas.cov_center_radius, float)
     fit = Contribution("circle_fit", R_part_left @ cov[:3, :3] @ R_part_left.T, 4.0 * cov[3, 3],
                        f"covariance of the circle fit ({int(meas.n_points)} points)")  # fmt: skip

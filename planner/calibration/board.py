@@ -1,7 +1,7 @@
 """The plain inputs of the calibration-view planner: the board and the stereo head.
 
 The planner never reads a cell file or a calibration file: the cell side builds these from its
-config (:mod:`cell.calibration_plan`) and hands them over as arrays and callables.
+config (:mod:`cell.calibration.plan`) and hands them over as arrays and callables.
 
 Board frame (``target``): OpenCV's board convention (``docs/conventions.md``): the features lie
 in its x-y plane (z = 0), in detector order, z points into the plate and the printed face faces

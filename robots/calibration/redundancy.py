@@ -11,7 +11,7 @@ observed:
 - for consecutive parallel axes (``alpha_i`` = 0 or pi), ``d_i`` and ``d_{i+1}`` slide along the
   same direction: only their sum is seen, so ``d_{i+1}`` is fixed.
 
-The numerical rank of the data (:mod:`cell.calibration.identifiability`) may name more.
+The numerical rank of the data (:mod:`cell.calibration.estimate.identifiability`) may name more.
 """
 
 from __future__ import annotations

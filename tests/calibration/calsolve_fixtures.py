@@ -8,8 +8,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from cell.calibration.observations import Cameras
-from cell.calibration.synthetic import (
+from cell.calibration.estimate import (
+    Cameras,
     SyntheticTruth,
     example_truth,
     seen_view_joints,

@@ -12,9 +12,8 @@ import numpy as np
 import pytest
 from calsolve_fixtures import SMALL_STEREO, seen_views, small_truth, write_rendered_set
 
-from cell.calibration.modelfile import load_calibration
-from cell.calibration.solve import pose_error
-from cell.calibration.synthetic import truth_in_gauge
+from cell.calibration.estimate import pose_error, truth_in_gauge
+from cell.calibration.file import load_calibration
 from cell.cli import build_parser, main
 from cell.config import load_cell
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cell.calibration.covariance import ViewWhitening, white_covariance
+from cell.calibration.estimate import ViewWhitening, white_covariance
 
 
 def test_the_whitening_turns_omega_into_the_identity() -> None:

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cell.calibration.modelfile import load_calibration
-from cell.calibration.solve import pose_error
+from cell.calibration.estimate import pose_error
+from cell.calibration.file import load_calibration
 from cell.cli import main
 
 

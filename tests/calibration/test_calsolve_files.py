@@ -11,18 +11,16 @@ import numpy as np
 import pytest
 from calsolve_fixtures import seen_views
 
-from cell.calibration.apply import CalibratedKinematics
 from cell.calibration.errors import CalibrationFileError
-from cell.calibration.modelfile import (
+from cell.calibration.estimate import Provenance, example_truth, simulate, solve_calibration
+from cell.calibration.file import (
     calibration_to_dict,
     check_age,
     check_belongs,
     load_calibration,
     save_calibration,
 )
-from cell.calibration.result import Provenance
-from cell.calibration.solve import solve_calibration
-from cell.calibration.synthetic import example_truth, simulate
+from cell.calibration.use import CalibratedKinematics
 from robots.calibration import calibrated_table, fk_with_errors
 
 PROV = Provenance("abb_irb1600_10_145", "r" * 16, "t" * 16, "c" * 16, "stereo.json", "s" * 16)
@@ -119,7 +117,7 @@ def test_the_point_covariance_is_the_spread_of_sampled_calibrations(solved, fram
     """Draw the free parameters from their covariance, move a point fixed in the camera:
     its scatter matches ``point_covariance`` (first order: errors are micrometres)."""
     tr, cal = solved
-    from cell.calibration.model import State, step_state
+    from cell.calibration.estimate import State, step_state
 
     ck = CalibratedKinematics(cal)
     q = seen_views(tr, 1, seed=9)[0]

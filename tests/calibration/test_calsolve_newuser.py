@@ -11,7 +11,7 @@ import pytest
 from calsolve_fixtures import SMALL_STEREO, seen_views, small_truth, write_rendered_set
 
 from cell.calibration.errors import CalibrationDataError
-from cell.calibration.posecsv import read_pose_csv
+from cell.calibration.inputs import read_pose_csv
 from cell.cli import main
 from cell.commands.calibrate_report import dh_term_text
 
@@ -79,7 +79,7 @@ def test_a_wrong_board_size_is_hinted_when_no_image_shows_the_target(
 def test_the_board_size_search_is_bounded_and_says_so(
     rendered: Path, tmp_path: Path, capsys, monkeypatch
 ) -> None:
-    from cell.calibration import images
+    from cell.calibration.inputs import images
 
     d = _copy(rendered, tmp_path / "views")
     monkeypatch.setattr(images, "HINT_ROWS", 2)

@@ -1,14 +1,20 @@
-"""OpenCV's hand-eye conventions, as cell.calibration.initial uses them, on exact poses."""
+"""OpenCV's hand-eye conventions, as cell.calibration.estimate.initial uses them, on exact poses."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 
-from cell.calibration.initial import hand_eye_candidates, initial_estimate
-from cell.calibration.model import flange_poses
-from cell.calibration.solve import pose_error
-from cell.calibration.synthetic import example_truth, reference_joints, simulate, view_joints
+from cell.calibration.estimate import (
+    example_truth,
+    flange_poses,
+    hand_eye_candidates,
+    initial_estimate,
+    pose_error,
+    reference_joints,
+    simulate,
+    view_joints,
+)
 from robots.calibration import fk_with_errors
 
 

@@ -7,9 +7,14 @@ import pytest
 from calsolve_fixtures import seen_views
 
 from cell.calibration.errors import CalibrationDataError, DegenerateCalibrationError
-from cell.calibration.observations import CalibrationObservations, CalibrationView
-from cell.calibration.solve import solve_calibration
-from cell.calibration.synthetic import example_truth, reference_joints, simulate
+from cell.calibration.estimate import (
+    CalibrationObservations,
+    CalibrationView,
+    example_truth,
+    reference_joints,
+    simulate,
+    solve_calibration,
+)
 from robots.dh_models import dh_table
 
 

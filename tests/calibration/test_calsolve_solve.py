@@ -8,13 +8,16 @@ import pytest
 from calsolve_fixtures import seen_views
 from scipy.stats import chi2
 
-from cell.calibration.model import column_names, predict, step_state
-from cell.calibration.solve import SolveOptions, solve_calibration
-from cell.calibration.synthetic import (
+from cell.calibration.estimate import (
+    SolveOptions,
+    column_names,
     example_truth,
     parameter_errors,
+    predict,
     reference_joints,
     simulate,
+    solve_calibration,
+    step_state,
     truth_in_gauge,
     view_joints,
 )

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from cell.config import CellConfig, builtin_cell_path, load_cell
-from cell.gdt.datums import without_drawing
+from cell.config.datums import without_drawing
 from cell.run.reference import plan_reference_tour
 from planner import Options, Tour, plan_tour
 from robots.thermal.drift import DriftSettings, WarmUp

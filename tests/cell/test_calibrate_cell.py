@@ -16,17 +16,21 @@ import numpy as np
 import pytest
 import yaml
 
-from cell.calibration.modelfile import check_belongs, load_calibration
-from cell.calibration.provenance import cell_provenance
-from cell.calibration.solve import pose_error
-from cell.calibration_plan import CalibrationPlanOptions, cell_target, plan_calibration
-from cell.calibration_run.orient import orient_chessboard, refine_corners
-from cell.calibration_run.plan import CALIBRATE_MARGIN_FRAC, CALIBRATE_OFFSETS
+from cell.calibration.capture import orient_chessboard, refine_corners
+from cell.calibration.estimate import pose_error
+from cell.calibration.file import cell_provenance, check_belongs, load_calibration
+from cell.calibration.plan import (
+    CALIBRATE_MARGIN_FRAC,
+    CALIBRATE_OFFSETS,
+    CalibrationPlanOptions,
+    cell_target,
+    plan_calibration,
+)
+from cell.camera import cell_stereo
 from cell.cli import main
 from cell.config import builtin_cell_path, load_cell
-from cell.run.camera import cell_stereo
-from cell.run.reference import hole_stops
-from cell.sim.calibration_truth import calibration_tcp_errors_m, true_state
+from cell.config.tours import hole_stops
+from cell.demo.calibration_truth import calibration_tcp_errors_m, true_state
 from cell.sim.camserver import CameraServer
 from cell.sim.session import SimCell
 from cell.sim.truth import CellTruth
@@ -184,7 +188,7 @@ def test_chessboard_corners_come_in_the_board_order(roll_deg: float) -> None:
 @pytest.mark.slow
 def test_calibrate_cell_full_head_30_views(tmp_path: Path, capsys) -> None:
     """The built-in cell's head, 30 views planned as calibrate cell plans them, seed 1."""
-    from cell.calibration_run.plan import calibrate_plan_options, plan_cell_calibration
+    from cell.calibration.plan import calibrate_plan_options, plan_cell_calibration
 
     cell = load_cell(None)
     tour = tmp_path / "caltour.json"
@@ -202,7 +206,7 @@ def test_calibrate_cell_full_head_30_views(tmp_path: Path, capsys) -> None:
 
 
 def test_a_corner_off_the_plate_plane_is_refined_again() -> None:
-    from cell.calibration_run.orient import plane_outliers, repair_outliers
+    from cell.calibration.capture import plane_outliers, repair_outliers
 
     spec = load_cell(None).calibration_target.target_spec()
     st = toed_in_stereo(image_size=SMALL_SIZE, pixel_m=4 * STANDARD_PIXEL_M)

@@ -10,13 +10,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cell.calibration.model import corrected
-from cell.calibration.observations import Cameras
-from cell.calibration.solve import SolveOptions, pose_error, solve_calibration
-from cell.calibration.synthetic import (
+from cell.calibration.estimate import (
+    Cameras,
+    SolveOptions,
+    corrected,
     example_truth,
+    pose_error,
     reference_joints,
     simulate,
+    solve_calibration,
     truth_in_gauge,
     view_joints,
 )

@@ -1,23 +1,23 @@
-"""The information-based design of the calibration views (cell.calibration_plan.design)."""
+"""The information-based design of the calibration views (cell.calibration.plan.design)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from cell.calibration.model import column_names, perturb_pose
-from cell.calibration.observations import Cameras
-from cell.calibration_plan.design import (
-    _state,
+from cell.calibration.estimate import Cameras, column_names, perturb_pose
+from cell.calibration.plan import (
+    TargetGeometry,
+    board_of,
     design_rows,
     information_model,
     point_sensitivity,
     predict_sigmas,
+    stereo_model,
 )
-from cell.calibration_plan.head_model import stereo_model
-from cell.calibration_plan.target import TargetGeometry, board_of
+from cell.calibration.plan.design import _state
+from cell.camera import cell_stereo
 from cell.config import load_builtin_cell
-from cell.run.camera import cell_stereo
 from planner.calibration import candidate_views, preselect
 from robots.calibration import fk_with_errors
 from robots.transforms import make_transform, rpy_to_matrix

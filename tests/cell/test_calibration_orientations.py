@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from cell.calibration_plan.orientations import orientation_figures
+from cell.calibration.plan import orientation_figures
 from cell.commands.plan_calibration_cmd import orientation_line
 
 

@@ -1,4 +1,4 @@
-"""holecell plan-calibration: the calibration tour of a cell (cell.calibration_plan)."""
+"""holecell plan-calibration: the calibration tour of a cell (cell.calibration.plan)."""
 
 from __future__ import annotations
 
@@ -6,12 +6,16 @@ import numpy as np
 import pytest
 import yaml
 
-from cell.calibration_plan.plan import CalibrationPlanOptions, joint_range, plan_calibration
-from cell.calibration_plan.target import TargetGeometry
+from cell.calibration.plan import (
+    CalibrationPlanOptions,
+    TargetGeometry,
+    joint_range,
+    plan_calibration,
+)
+from cell.camera import cell_stereo
 from cell.cli import main
 from cell.config import builtin_cell_path, load_builtin_cell
 from cell.errors import CellError
-from cell.run.camera import cell_stereo
 from planner import Options
 from planner.calibration import load_caltour
 from robots.transforms import make_transform, rpy_to_matrix

@@ -1,8 +1,8 @@
 """The calibration tour's predicted σ against the adjustment itself on simulated data.
 
-The views of a design are simulated with a drawn truth (``cell.calibration.synthetic``), solved
-by ``cell.calibration.solve`` and the errors against the truth (in the adjustment's gauge)
-divided by the predicted σ: they should scatter with unit RMS.
+The views of a design are simulated with a drawn truth (``cell.calibration.estimate.synthetic``),
+solved by ``cell.calibration.estimate.solve`` and the errors against the truth (in the adjustment's
+gauge) divided by the predicted σ: they should scatter with unit RMS.
 """
 
 from __future__ import annotations
@@ -10,14 +10,25 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cell.calibration.observations import Cameras
-from cell.calibration.solve import SolveOptions, solve_calibration
-from cell.calibration.synthetic import parameter_errors, random_truth, simulate, truth_in_gauge
-from cell.calibration_plan.design import design_rows, information_model, predict_sigmas
-from cell.calibration_plan.head_model import stereo_model
-from cell.calibration_plan.target import TargetGeometry, board_of
+from cell.calibration.estimate import (
+    Cameras,
+    SolveOptions,
+    parameter_errors,
+    random_truth,
+    simulate,
+    solve_calibration,
+    truth_in_gauge,
+)
+from cell.calibration.plan import (
+    TargetGeometry,
+    board_of,
+    design_rows,
+    information_model,
+    predict_sigmas,
+    stereo_model,
+)
+from cell.camera import cell_stereo
 from cell.config import load_builtin_cell
-from cell.run.camera import cell_stereo
 from planner.calibration import candidate_views
 from robots.transforms import invert, make_transform, rpy_to_matrix
 

@@ -12,9 +12,9 @@ import pytest
 from cell_fixtures import SmallCell
 
 import cell.run.inspect as ih
+from cell.camera import cell_stereo
+from cell.records.hole_result import HoleResult
 from cell.review.report import summary, write_report
-from cell.run.camera import cell_stereo
-from cell.run.results import HoleResult
 from cell.run.setup import start_run
 from measure import head_frame
 from robots.transforms import invert

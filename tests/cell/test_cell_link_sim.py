@@ -41,7 +41,7 @@ def controller(request) -> str:
 
 def _server(controller: str, faults: FaultPlan | None = None, transport: str = "pty", **kw):
     temps = lambda t: np.array([20.0 + 0.01 * t, 21.0])  # noqa: E731
-    clock = SimClock(kw.pop("speed", 50.0))
+    clock = kw.pop("clock", None) or SimClock(kw.pop("speed", 50.0))
     if controller == "rapid":
         return RapidController(clock, temps, "abb_test", HOME, faults, transport, **kw).start()
     ctrl = SimController(clock, temps, "abb_test", HOME, **kw)
@@ -71,11 +71,17 @@ def test_identify_load_move_and_status(transport: str, controller: str) -> None:
 
 def test_moves_backwards_along_the_path_and_stop_holds(controller: str) -> None:
     q, stops = _trajectory()
-    with _server(controller, speed=5.0) as sim, ControllerClient(sim.url, _fast(controller)) as c:
+    clock = SimClock(1.0)
+    with (
+        _server(controller, clock=clock) as sim,
+        ControllerClient(sim.url, _fast(controller)) as c,
+    ):
         c.load_trajectory(q, stops, 0.004)
         c.move_to_stop(2)
-        time.sleep(0.08)
-        c.stop()
+        while c.status().row == 0:  # on its way (no wall-clock guess of when that is)
+            pass
+        with clock.held():  # the arm cannot arrive while the stop request travels
+            c.stop()
         st = c.status()
         assert st.state == m.State.STOPPED and 0 < st.row < stops[2]
         c.move_to_stop(0)

@@ -44,8 +44,11 @@ def _inprocess_run(sc: SmallCell, run_dir: Path, sim: SimCell, link: LinkOptions
 def test_dropped_corrupted_frames_and_a_disconnect(
     small_cell: SmallCell, tmp_path: Path, controller: str, transport: str
 ) -> None:
-    faults = FaultPlan(drop=0.05, corrupt=0.02, disconnect_after=50, disconnect_s=1.5, seed=7)
     link = LinkOptions(response_timeout_s=0.04, retries=8, heartbeat_period_s=0.1)
+    # the outage swallows every attempt of the request it meets, however slowly the simulated
+    # controller reads them: the client must give up and reconnect (not a race with the clock)
+    faults = FaultPlan(drop=0.05, corrupt=0.02, disconnect_after=50, disconnect_s=1.5,
+                       disconnect_frames=link.retries + 1, seed=7)  # fmt: skip
     world = WorldOptions(speed=20.0, drift=steady_drift())
     with SimCell.start(small_cell.cell, world, faults, transport,
                        controller=controller) as sim:  # fmt: skip

@@ -9,8 +9,8 @@ from pathlib import Path
 
 from cell_fixtures import SmallCell
 
+from cell.records.hole_result import HoleResult
 from cell.review.report import write_report
-from cell.run.results import HoleResult
 from cell.run.setup import start_run
 
 

@@ -11,8 +11,9 @@ from cell_fixtures import SmallCell, link_for
 
 from cell.cli import main
 from cell.link.client import ControllerClient, LinkOptions
+from cell.link.errors import RunFaultError
 from cell.review.store import Store
-from cell.run.runner import RunFaultError, Runner, RunOptions
+from cell.run.runner import Runner, RunOptions
 from cell.run.setup import resume_run, start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan

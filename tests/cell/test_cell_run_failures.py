@@ -10,12 +10,13 @@ from pathlib import Path
 import pytest
 from cell_fixtures import SmallCell, link_for, steady_drift
 
+from cell.camera import CameraError
 from cell.cli import main
 from cell.link import messages as m
 from cell.link.client import ControllerClient, LinkOptions
+from cell.link.errors import RunFaultError
 from cell.review.store import Store
-from cell.run.camera import CameraError
-from cell.run.runner import RunFaultError, Runner, RunOptions
+from cell.run.runner import Runner, RunOptions
 from cell.run.setup import start_run
 from cell.sim.camserver import CameraServer
 from cell.sim.rapid_controller import RapidController

@@ -10,11 +10,13 @@ import numpy as np
 import pytest
 from cell_fixtures import SmallCell, link_for, steady_drift
 
+from cell.demo.demo import truth_error
+from cell.errors import TourMismatchError
 from cell.link.client import ControllerClient, LinkOptions
+from cell.link.errors import RunFaultError
 from cell.review.store import Store
-from cell.run.demo import truth_error
-from cell.run.runner import RunFaultError, Runner, RunOptions
-from cell.run.setup import TourMismatchError, resume_run, start_run
+from cell.run.runner import Runner, RunOptions
+from cell.run.setup import resume_run, start_run
 from cell.sim.faults import FaultPlan
 from cell.sim.rapid_controller import RapidController
 from cell.sim.session import SimCell

@@ -11,9 +11,9 @@ import pytest
 import yaml
 
 from cell.config import builtin_cell_path
+from cell.records.hole_result import HoleResult
 from cell.review.report import write_report
 from cell.review.store import Store, StoreError
-from cell.run.results import HoleResult
 
 
 def _cell_text() -> str:

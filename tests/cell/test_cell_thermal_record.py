@@ -82,7 +82,7 @@ def test_given_model_sets_the_cold_state_of_a_warm_arm(small_cell: SmallCell, tm
     model identifies relative to that model's reference temperatures (the cold state it knows),
     not the warm readings of its first round, and so still compensates the whole warm-up (taking
     the warm readings as reference leaves most of the drift: a ratio near 1)."""
-    from cell.run.demo import truth_error
+    from cell.demo.demo import truth_error
     from cell.run.thermal_update import sensor_spec
     from robots.thermal.model import ThermalModel
 

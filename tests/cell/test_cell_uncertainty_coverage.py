@@ -15,8 +15,8 @@ from dataclasses import replace
 import numpy as np
 from cell_fixtures import SmallCell, steady_drift
 
-from cell.run.camera import cell_stereo
-from cell.run.demo import truth_error
+from cell.camera import cell_stereo
+from cell.demo.demo import truth_error
 from cell.run.inspect import inspect_hole
 from cell.sim.camera import SimCamera
 from cell.sim.truth import CellTruth

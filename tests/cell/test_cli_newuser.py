@@ -66,7 +66,7 @@ def test_an_output_that_is_a_folder_or_in_none_is_refused_before_any_work(
 )
 def test_a_bad_intrinsics_file_is_one_line(tmp_path: Path, capsys, text, words) -> None:
     from cell.calibration.errors import CalibrationDataError
-    from cell.calibration.intrinsics import read_intrinsics
+    from cell.calibration.inputs import read_intrinsics
 
     p = tmp_path / "camera.yaml"
     if text is None:

@@ -15,19 +15,20 @@ import yaml
 from cell_fixtures import SmallCell
 
 from cell.calibration.errors import CalibrationFileError
-from cell.calibration.modelfile import save_calibration
-from cell.cli import main
-from cell.config import load_cell
-from cell.run.calibration import (
+from cell.calibration.file import save_calibration
+from cell.calibration.use import (
     MAX_AGE_DAYS,
     RunGeometry,
+    StopCorrectionError,
+    correct_tour,
     load_run_calibration,
     store_calibration,
 )
-from cell.run.camera import cell_stereo
-from cell.run.corrected_tour import StopCorrectionError, correct_tour
-from cell.run.motion import stop_rows
-from cell.run.sim_calibration import design_views, simulated_calibration
+from cell.camera import cell_stereo
+from cell.cli import main
+from cell.config import load_cell
+from cell.config.tours import stop_rows
+from cell.demo.sim_calibration import design_views, simulated_calibration
 from cell.sim.truth import CellTruth
 from cell.sim.world import SimWorld, WorldOptions
 from measure import head_frame
@@ -183,9 +184,8 @@ def test_run_refuses_a_calibration_of_another_cell_before_connecting(
 
 def test_the_calibration_is_stored_with_the_run(calibrated, tmp_path: Path) -> None:
     path, _, _ = calibrated
-    from cell.calibration.apply import CalibratedKinematics
-    from cell.calibration.modelfile import load_calibration
-    from cell.run.calibration import RunCalibration, calibration_summary
+    from cell.calibration.file import load_calibration
+    from cell.calibration.use import CalibratedKinematics, RunCalibration, calibration_summary
 
     cal = load_calibration(path)
     dest = store_calibration(RunCalibration(cal, CalibratedKinematics(cal), str(path)), tmp_path)
@@ -201,7 +201,7 @@ def test_the_run_triangulates_with_the_calibrated_stereo_extrinsics(
 ) -> None:
     """The calibration's ``T_left_right`` replaces the file's; the intrinsics stay the file's,
     and the calibrated TCP still carries the left camera to the calibrated hand-eye."""
-    from cell.run.calibration import calibrated_stereo
+    from cell.calibration.use import calibrated_stereo
 
     path, _, cal = calibrated
     cell = small_cell.cell
@@ -223,11 +223,10 @@ def test_a_resumed_run_uses_the_copy_it_stored(small_cell: SmallCell, calibrated
     new ``--calibration``; a run that stored none resumes without."""
     import argparse
 
-    from cell.calibration.apply import CalibratedKinematics
-    from cell.calibration.modelfile import load_calibration
+    from cell.calibration.file import load_calibration
+    from cell.calibration.use import CalibratedKinematics, RunCalibration
     from cell.commands.run_cmd import _calibration
     from cell.errors import CellError
-    from cell.run.calibration import RunCalibration
 
     path, _, _ = calibrated
     cal = load_calibration(path)

@@ -11,14 +11,14 @@ import numpy as np
 import pytest
 from cell_fixtures import SmallCell, steady_drift
 
-from cell.calibration.modelfile import save_calibration
+from cell.calibration.file import save_calibration
+from cell.calibration.use import load_run_calibration, store_calibration
+from cell.camera import cell_stereo
+from cell.demo.sim_calibration import design_views, simulated_calibration
 from cell.link.client import ControllerClient, LinkOptions
 from cell.review.report import write_report
-from cell.run.calibration import load_run_calibration, store_calibration
-from cell.run.camera import cell_stereo
 from cell.run.runner import Runner, RunOptions
 from cell.run.setup import start_run
-from cell.run.sim_calibration import design_views, simulated_calibration
 from cell.sim.session import SimCell
 from cell.sim.truth import CellTruth
 from cell.sim.world import WorldOptions
@@ -98,7 +98,7 @@ def test_a_run_with_the_calibration_measures_the_small_cell(
 
 @pytest.mark.slow
 def test_the_demo_calibrates_first_and_measures_in_the_datum_frame(tmp_path: Path) -> None:
-    from cell.run.demo import DemoOptions, run_demo
+    from cell.demo.demo import DemoOptions, run_demo
 
     res = run_demo(tmp_path / "run", DemoOptions(seed=1))
     assert res.calibration is not None and res.calibration.hand_eye_error_m < 0.05e-3

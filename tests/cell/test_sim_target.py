@@ -11,14 +11,14 @@ import numpy as np
 import pytest
 import yaml
 
+from cell.camera import cell_stereo
 from cell.config import builtin_cell_path, load_builtin_cell, load_cell
 from cell.errors import ConfigError
-from cell.reach import viewpoint
-from cell.run.camera import cell_stereo
 from cell.sim.camera import SimCamera
 from cell.sim.truth import CellTruth
 from cell.sim.world import SimWorld, WorldOptions
 from measure.target import find_target
+from planner.reach import viewpoint
 
 
 class _Arm:

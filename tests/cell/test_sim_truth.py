@@ -174,7 +174,7 @@ def test_world_applies_each_error(cell) -> None:
 
 
 def test_demo_world_takes_the_truth(cell) -> None:
-    from cell.run.demo import DemoOptions, demo_truth, demo_world
+    from cell.demo.demo import DemoOptions, demo_truth, demo_world
 
     t = CellTruth.drawn(8, cell)
     assert demo_world(cell, DemoOptions(truth=t)).truth is t

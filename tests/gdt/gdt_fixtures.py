@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cell.run.results import HoleResult
+from cell.records.hole_result import HoleResult
 
 SIGMA_M = 8e-6
 

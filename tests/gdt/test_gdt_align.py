@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from cell.config.datums import Datum
 from cell.gdt.align import best_fit_frame, datum_frame, kabsch, minimax
-from cell.gdt.datums import Datum
 
 # a plate in the x-z plane at y = 0.167 (normal +y) and two holes off it, like the frame's
 PLATE = {

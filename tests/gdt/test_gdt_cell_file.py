@@ -7,8 +7,8 @@ import pytest
 import yaml
 
 from cell.config import builtin_cell_path, load_builtin_cell, parse_cell
+from cell.config.datums import without_drawing
 from cell.errors import ConfigError
-from cell.gdt.datums import without_drawing
 
 
 def _data() -> dict:

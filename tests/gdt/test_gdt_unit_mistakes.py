@@ -8,8 +8,8 @@ import yaml
 
 from cell.cli import main
 from cell.config import builtin_cell_path, parse_cell
+from cell.config.datums import without_drawing
 from cell.errors import ConfigError
-from cell.gdt.datums import without_drawing
 
 
 def _data() -> dict:

@@ -9,7 +9,7 @@ import yaml
 
 from cell.cli import main
 from cell.config import builtin_cell_path
-from cell.gdt.datums import without_drawing
+from cell.config.datums import without_drawing
 from planner import load_tour
 
 

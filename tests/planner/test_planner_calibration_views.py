@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from cell.calibration_plan.head_model import stereo_model
+from cell.calibration.plan import stereo_model
 from cell.config import load_builtin_cell
 from measure.synth import standard_stereo
 from measure.target import TargetSpec

@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from cell.config import builtin_cell_path, load_builtin_cell, parse_cell
-from cell.gdt.datums import without_drawing
+from cell.config.datums import without_drawing
 from planner import (
     Options,
     Tour,

@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from cell.config import builtin_cell_path, parse_cell
-from cell.gdt.datums import without_drawing
+from cell.config.datums import without_drawing
 from planner import Options
 from planner.engines import LocalEngine, RayEngine
 from planner.errors import EngineError, PlanningError, StartsFailedError

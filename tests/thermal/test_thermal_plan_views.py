@@ -12,7 +12,7 @@ import yaml
 from cell.cli import main
 from cell.commands.thermal_plan_cmd import VIEW_COLUMNS, read_views
 from cell.config import builtin_cell_path, load_cell
-from cell.gdt.datums import without_drawing
+from cell.config.datums import without_drawing
 from planner import Options, plan_tour
 
 

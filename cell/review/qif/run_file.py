@@ -11,9 +11,9 @@ from pydantic import ValidationError
 
 from cell.config import CellConfig, parse_cell
 from cell.errors import ConfigError
+from cell.records.hole_result import HoleResult
 from cell.review.qif.document import write_qif
 from cell.review.qif.features import HoleNominal
-from cell.run.results import HoleResult
 
 
 def hole_nominals(info: Mapping[str, Any], where: str) -> dict[str, HoleNominal]:

@@ -1,0 +1,14 @@
+"""Errors of the camera backends, derived from :class:`cell.errors.CellError`."""
+
+from __future__ import annotations
+
+from cell.errors import CellError
+
+
+class CameraError(CellError):
+    """A capture failed (camera not reachable, bad image transfer)."""
+
+    def __init__(self, source: str, reason: str) -> None:
+        self.source = source
+        self.reason = reason
+        super().__init__(f"camera {source}: {reason}")

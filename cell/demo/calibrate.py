@@ -1,0 +1,130 @@
+"""The demo's first step: calibrate the simulated cell, and how good that calibration is.
+
+Two ways (``DemoOptions.calibration_method``):
+
+- ``"images"``: :func:`calibrate_demo_cell_images` runs the calibration tour (planned as
+  ``holecell calibrate cell`` plans it, :func:`plan_demo_caltour`) on the simulated controller
+  and head with :func:`cell.calibration.capture.tour.run_calibration_tour`: the plate rendered in
+  both cameras at every view, detected, one adjustment. The whole procedure of a real cell.
+- ``"projected"``: :func:`calibrate_demo_cell` (:mod:`cell.demo.sim_calibration`): the plate's
+  corners projected through the simulated cell's true geometry at the planner's feasible views
+  chosen over the hole tour's joint range, corner noise and the arm's repeatability added, one
+  adjustment. Seconds instead of minutes; no detector, no tour driven.
+
+Either writes ``RUN_DIR/cellcal.json`` and measures the estimate against the simulation's
+truth (the hand-eye in the calibration's gauge: the structurally redundant D-H terms folded
+into it, :func:`cell.calibration.estimate.synthetic.truth_in_gauge`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from cell.calibration.estimate import CellCalibration, SolveOptions, pose_error, truth_in_gauge
+from cell.calibration.file import save_calibration
+from cell.calibration.use import RUN_FILENAME
+from cell.config import CellConfig
+from cell.demo.sim_calibration import design_views, simulated_calibration, synthetic_truth
+from cell.sim.session import SimCell
+from planner import Tour
+from planner.calibration import CalibrationTour
+
+#: the demo's calibration tour is chosen by the geometric pre-selection (rotations, image
+#: cover, the hole tour's joint range), without the predicted sigma: as accurate here as the
+#: I-optimal design (docs/calibration.md, "The demo") and 45 s less planning
+CALTOUR_CRITERION = "geometric"
+
+
+@dataclass(frozen=True)
+class DemoCalibration:
+    """The demo's calibration: the file, its estimate, the wall time (s), the hand-eye's error
+    against the truth (m, rad), the D-H terms fixed and the method."""
+
+    path: Path
+    calibration: CellCalibration
+    seconds: float
+    hand_eye_error_m: float
+    hand_eye_error_rad: float
+    fixed_terms: tuple[str, ...]
+    method: str
+
+    @property
+    def hand_eye_sigma_m(self) -> float:
+        """Root sum of the hand-eye's position variances (m)."""
+        return float(np.linalg.norm(self.calibration.T_tool0_camera.sigma_xyz_m))
+
+    @property
+    def hand_eye_sigma_rad(self) -> float:
+        """Root sum of the hand-eye's rotation variances (rad)."""
+        return float(np.linalg.norm(self.calibration.T_tool0_camera.sigma_rot_rad))
+
+
+def calibrate_demo_cell(
+    sim: SimCell, cell: CellConfig, tour: Tour, run_dir: Path, views: int, seed: int
+) -> DemoCalibration:
+    """Calibrate the simulated cell of ``sim`` for the hole tour ``tour`` (its joint range)
+    and write ``run_dir/cellcal.json``."""
+    t0 = time.perf_counter()
+    geometry = sim.world.true_geometry()
+    stereo = sim.camera.stereo
+    q_views = design_views(cell, stereo, np.array([s.q for s in tour.stops]), views)
+    res = simulated_calibration(cell, geometry, stereo, sim.world.truth.repeatability_rp_m,
+                                q_views, seed=seed, true_stereo=sim.camera.true_stereo)  # fmt: skip
+    path = Path(run_dir) / RUN_FILENAME
+    save_calibration(res.calibration, path)
+    seconds = time.perf_counter() - t0
+    gauge = truth_in_gauge(synthetic_truth(cell, geometry, stereo))
+    dp, dr = pose_error(res.calibration.T_tool0_camera.T, gauge.T_tool0_camera)
+    fixed = tuple(t.name for t in res.calibration.dh_terms if not t.free)
+    method = (f"{len(q_views)} views of the plate (planner's feasible views; corners projected "
+              "through the simulated cell, not rendered)")  # fmt: skip
+    return DemoCalibration(path, res.calibration, seconds, dp, dr, fixed, method)
+
+
+def plan_demo_caltour(views: int, seed: int) -> dict:
+    """The built-in cell's calibration tour as ``holecell calibrate cell`` plans it (JSON-ready:
+    planned in a worker process)."""
+    from cell.calibration.plan import calibrate_plan_options, plan_cell_calibration
+    from cell.camera import cell_stereo
+    from cell.config import load_builtin_cell
+
+    cell = load_builtin_cell()
+    opts = replace(calibrate_plan_options(views, seed), criterion=CALTOUR_CRITERION,
+                   predict=False)  # fmt: skip
+    return plan_cell_calibration(cell, cell_stereo(cell), opts).to_dict()
+
+
+def calibrate_demo_cell_images(
+    sim: SimCell, cell: CellConfig, caltour: CalibrationTour, run_dir: Path, speed: float
+) -> DemoCalibration:
+    """Run ``caltour`` on the simulated cell at ``speed`` (x real time), detect, solve
+    (:func:`cell.calibration.capture.tour.run_calibration_tour`); write ``run_dir/cellcal.json``."""
+    from cell.calibration.capture import CalibrateCellOptions, CaptureSettings, run_calibration_tour
+    from cell.link.client import ControllerClient
+
+    t0 = time.perf_counter()
+    sim.world.clock.set_speed(speed)
+    try:
+        opts = CalibrateCellOptions(
+            capture=CaptureSettings(settle_s=0.2 / speed),
+            solve=SolveOptions(estimate_intrinsics=True),
+        )  # as the CLI
+        with ControllerClient(sim.url) as client:
+            run = run_calibration_tour(cell, caltour, client, sim.camera, opts)
+    finally:
+        sim.world.clock.set_speed(1.0)
+    cal = run.result.calibration
+    path = Path(run_dir) / RUN_FILENAME
+    save_calibration(cal, path)
+    seconds = time.perf_counter() - t0
+    gauge = truth_in_gauge(synthetic_truth(cell, sim.world.true_geometry(), sim.camera.stereo))
+    dp, dr = pose_error(cal.T_tool0_camera.T, gauge.T_tool0_camera)
+    fixed = tuple(t.name for t in cal.dh_terms if not t.free)
+    method = (f"calibration tour of {len(caltour.tour.stops)} views driven on the simulated "
+              f"controller ({run.captures.robot_time_s:.0f} s robot time), plate rendered and "
+              f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s")  # fmt: skip
+    return DemoCalibration(path, cal, seconds, dp, dr, fixed, method)

@@ -1,0 +1,281 @@
+"""The whole job on the built-in cell with the simulated controller and cameras.
+
+Plan the tour of the built-in motorcycle frame (and the reference-target tour), start the
+simulated cell on a pseudo-terminal with a cold arm (in real time), let the runner take the cold
+readings and measure the reference targets while the arm warms up (from the first round on, the
+simulation fast-forwards the warm-up at ``warmup_speed``), identify
+the thermal model, then measure every hole at ``run_speed``. Since the simulation knows the
+truth, the result also holds the measurement error against it, with and without compensation.
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import time
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cell.calibration.use import RunCalibration, load_run_calibration
+from cell.config import CellConfig, load_builtin_cell
+from cell.demo.calibrate import (
+    DemoCalibration,
+    calibrate_demo_cell,
+    calibrate_demo_cell_images,
+    plan_demo_caltour,
+)
+from cell.demo.truth_error import DatumError, TruthError, datum_truth_error, truth_error
+from cell.link.client import ControllerClient
+from cell.review.report import write_report
+from cell.run.reference import plan_reference_tour
+from cell.run.runner import Progress, Runner, RunOptions, RunResult
+from cell.run.setup import RunFiles, check_new_run_dir, start_run
+from cell.sim.faults import FaultPlan
+from cell.sim.session import SimCell
+from cell.sim.truth import CellTruth
+from cell.sim.world import WorldOptions
+from cell.uncertainty.decision import DEFAULT_RULE
+from cell.uncertainty.repeatability import repeatability_rp_m
+from planner import Options, Tour, TourPlanner
+from planner.calibration import CalibrationTour, caltour_from_dict
+from planner.tour import tour_from_dict
+
+
+@dataclass(frozen=True)
+class DemoOptions:
+    """Settings of the demo.
+
+    Attributes:
+        warmup_speed: simulation speed while the reference targets are measured (x real time).
+        run_speed: simulation speed while the holes are measured.
+        reference_rounds: rounds over the reference targets during the warm-up.
+        reference_interval_s: simulated seconds between two rounds.
+        faults: what the simulated controller does wrong (none by default).
+        seed: seed of the part's true geometry, sensor noise and image noise (a ``truth``
+            carries its own).
+        part_temperature_c: the simulated part's true temperature (degC; None: the truth's, or
+            23 degC without one); the run is given a thermometer reading of it
+            (``thermometer_sigma_K`` noise, stated as ``u_part_temperature_K``).
+        realistic: the simulated cell has the errors a real one has and the budget claims:
+            the arm scatters by its data-sheet repeatability, the true head differs from its
+            calibration by a draw from the calibration's uncertainty, the part's expansion
+            coefficient by a draw from its material's (False: a perfect arm and head, no
+            geometric error: :meth:`CellTruth.zero`, and no calibration).
+        geometry_errors: without a ``truth``, the realistic cell also has the geometric errors
+            of a real one, drawn from the seed (:meth:`CellTruth.drawn`: D-H, head mount, base,
+            part and plate placement); False: none (the demo before issue 18).
+        calibrate: run the cell calibration on the simulated cell first and measure the part
+            with it (False: ``--no-calibration``, the nominal kinematics).
+        calibration_views: views of the plate of that calibration.
+        calibration_method: ``"images"`` (default): the calibration tour driven on the
+            simulated cell, the plate rendered and detected in both cameras (``calibrate
+            cell``'s procedure; about a minute for 120 views); ``"projected"``: the plate's
+            corners projected at the planner's views (seconds, no detector; for benchmarks
+            over many seeds, :mod:`cell.demo.calibrate`).
+        calibration_speed: simulation speed while the calibration tour is driven (the
+            simulated arm warms with the simulated time, whatever the speed).
+        truth: every hidden error of the simulated cell (a truth file, ``--truth``); None:
+            the drawn truth above (or, without ``geometry_errors``, no geometric error).
+        decision_rule: the run's decision rule.
+        operator: the report's operator field.
+    """
+
+    warmup_speed: float = 1500.0
+    run_speed: float = 10.0
+    reference_rounds: int = 6
+    reference_interval_s: float = 600.0
+    faults: FaultPlan = field(default_factory=FaultPlan)
+    seed: int = 0
+    part_temperature_c: float | None = None
+    thermometer_sigma_K: float = 0.1  # noqa: N815 (unit suffix)
+    u_part_temperature_K: float = 0.2  # noqa: N815 (unit suffix)
+    realistic: bool = True
+    geometry_errors: bool = True
+    calibrate: bool = True
+    calibration_views: int = 120
+    calibration_method: str = "images"
+    calibration_speed: float = 5.0
+    decision_rule: str = DEFAULT_RULE
+    operator: str = ""
+    truth: CellTruth | None = None
+
+
+#: the demo's part temperature without a truth file or a figure (degC)
+DEMO_PART_TEMPERATURE_C = 23.0
+
+
+@dataclass
+class DemoResult:
+    """Outcome of :func:`run_demo`."""
+
+    run_dir: Path
+    tour: Tour
+    run: RunResult
+    summary: dict[str, Any]
+    truth: TruthError
+    timings: dict[str, float]
+    datum: DatumError | None = None
+    calibration: DemoCalibration | None = None
+
+
+def _plan_reference(seed: int) -> dict[str, Any]:
+    # views the arm cannot reach are expected; the tour lists them in left_out
+    logging.getLogger("planner").setLevel(logging.ERROR)
+    return plan_reference_tour(load_builtin_cell(), Options(seed=seed)).to_dict()
+
+
+def plan_demo(
+    cell: CellConfig,
+    seed: int,
+    plan_progress: Callable[[str, int, int], None] | None = None,
+    caltour_views: int = 0,
+) -> tuple[Tour, Tour, CalibrationTour | None]:
+    """The hole tour, the reference tour and (``caltour_views`` > 0) the calibration tour of
+    ``cell``; the other two are planned in worker processes while this one plans the holes.
+    The workers are started by a fork server, not forked from this one: a process that has
+    run a simulator or a planner holds threads (and their locks) that a forked child would
+    inherit locked."""
+    ctx = multiprocessing.get_context("forkserver")
+    with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
+        ref_job = pool.submit(_plan_reference, seed)
+        cal_job = pool.submit(plan_demo_caltour, caltour_views, seed) if caltour_views else None
+        tour = TourPlanner(Options(seed=seed), plan_progress).plan(cell)
+        reference = tour_from_dict(ref_job.result(), "reference tour")
+        caltour = None if cal_job is None else caltour_from_dict(cal_job.result(), "caltour")
+    return tour, reference, caltour
+
+
+def run_demo(
+    out_dir: str | Path,
+    options: DemoOptions | None = None,
+    plan_progress: Callable[[str, int, int], None] | None = None,
+    run_progress: Progress | None = None,
+    recorder_factory: Callable[..., Any] | None = None,
+) -> DemoResult:
+    """Plan, run and report the built-in cell in ``out_dir`` (created; refused before planning
+    if it is a file or holds a run already)."""
+    check_new_run_dir(out_dir, resumable=False)
+    opts = options or DemoOptions()
+    t0 = time.perf_counter()
+    cell = load_builtin_cell()
+    images = opts.calibrate and opts.realistic and opts.calibration_method == "images"
+    tour, reference, caltour = plan_demo(cell, opts.seed, plan_progress,
+                                         opts.calibration_views if images else 0)  # fmt: skip
+    t_plan = time.perf_counter() - t0
+    # real time until the first reference round starts (its readings are the cold state)
+    world = demo_world(cell, opts)
+    with SimCell.start(cell, world, opts.faults) as sim:
+        files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
+        recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
+        try:
+            cal, run_cal = _calibration(sim, files, opts, caltour)
+            result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder,
+                              run_cal)  # fmt: skip
+            truth = truth_error(sim.world, files.store.results())
+            results = files.store.results()
+        finally:
+            files.store.close()
+            if recorder is not None:
+                recorder.close()
+    summary = write_report(out_dir, opts.operator)
+    datum = datum_truth_error(sim.world, results, Path(out_dir))
+    timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
+               "calibration_s": cal.seconds if cal else 0.0,
+               "total_s": time.perf_counter() - t0}  # fmt: skip
+    return DemoResult(Path(out_dir), tour, result, summary, truth, timings, datum, cal)
+
+
+def _calibration(
+    sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None
+) -> tuple[DemoCalibration | None, RunCalibration | None]:
+    """Calibrate the simulated cell (``opts.calibrate`` and a realistic cell), write the
+    calibration into the run directory and load it back as the run does (checked)."""
+    if not (opts.calibrate and opts.realistic):
+        return None, None
+    run_dir = files.store.path.parent
+    if caltour is not None:
+        cal = calibrate_demo_cell_images(sim, files.cell, caltour, run_dir,
+                                         opts.calibration_speed)  # fmt: skip
+    else:
+        cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
+                                  opts.seed)  # fmt: skip
+    arm = files.cell.build_robot()
+    return cal, load_run_calibration(cal.path, files.cell, arm, sim.camera.stereo)
+
+
+def demo_world(cell: CellConfig, opts: DemoOptions) -> WorldOptions:
+    """The simulated cell of the demo: real time until the first reference round (its
+    readings are the cold state), the truth of :func:`demo_truth`; with ``realistic`` a true
+    expansion coefficient off the material's figure, drawn from its stated uncertainty."""
+    base = WorldOptions(speed=1.0, drift_offset_s=0.0, truth=demo_truth(cell, opts),
+                        part_thermometer_sigma_K=opts.thermometer_sigma_K)  # fmt: skip
+    if not opts.realistic:
+        return base
+    material, _ = cell.part_material()
+    rng = np.random.default_rng([base.seed, 0xA1FA])
+    alpha = material.alpha_per_K + rng.normal(0.0, material.u_alpha_per_K)
+    return replace(base, part_alpha_per_K=alpha)
+
+
+def demo_truth(cell: CellConfig, opts: DemoOptions) -> CellTruth:
+    """``opts.truth`` (its part temperature replaced by ``part_temperature_c`` if given); without
+    one and with ``realistic``: the realistic draw of the seed (:meth:`CellTruth.drawn`), or
+    without ``geometry_errors`` no geometric error, the arm's data-sheet repeatability and a
+    head off its calibration by a draw of its stated uncertainty; without ``realistic``:
+    :meth:`CellTruth.zero`."""
+    t = opts.part_temperature_c
+    if opts.truth is not None:
+        return opts.truth if t is None else replace(opts.truth, part_temperature_c=t)
+    if opts.realistic and opts.geometry_errors:
+        drawn = CellTruth.drawn(opts.seed, cell)
+        return drawn if t is None else replace(drawn, part_temperature_c=t)
+    truth = replace(CellTruth.zero(opts.seed),
+                    part_temperature_c=DEMO_PART_TEMPERATURE_C if t is None else t)  # fmt: skip
+    if not opts.realistic:
+        return truth
+    rp, _ = repeatability_rp_m(cell.robot.model, cell.robot.repeatability_m)
+    return replace(truth, repeatability_rp_m=rp, calibration_sigma_scale=1.0)
+
+
+def _speed_up(sim: SimCell, opts: DemoOptions, run_progress: Progress | None) -> Progress:
+    """Progress that fast-forwards the warm-up (``warmup_speed``) once the first reference
+    round has taken the cold readings, switches to ``run_speed`` for the holes, and passes
+    every event on."""
+
+    def progress(event: str, data: dict) -> None:
+        if event == "round" and data["round"] == 0:
+            sim.world.clock.set_speed(opts.warmup_speed)
+        if event == "state" and data["state"] == "inspecting":
+            sim.world.clock.set_speed(opts.run_speed)
+        if run_progress is not None:
+            run_progress(event, data)
+
+    return progress
+
+
+def _run_sim(
+    sim: SimCell,
+    files: RunFiles,
+    opts: DemoOptions,
+    progress: Progress,
+    recorder: Any,
+    calibration: RunCalibration | None = None,
+) -> RunResult:
+    """Run the stored tour on the simulated cell over its port."""
+    run_opts = RunOptions(
+        settle_s=0.2 / opts.run_speed,
+        reference_rounds=opts.reference_rounds,
+        reference_interval_s=opts.reference_interval_s,
+        part_temperature_c=sim.world.part_reading_c(),
+        u_part_temperature_K=opts.u_part_temperature_K,
+        decision_rule=opts.decision_rule,
+    )
+    with ControllerClient(sim.url) as client:
+        runner = Runner(files.cell, files.tour, files.store, client, sim.camera, run_opts,
+                        files.reference, None, progress, recorder, calibration)  # fmt: skip
+        return runner.run()
