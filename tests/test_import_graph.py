@@ -1,4 +1,5 @@
-"""No import circles between the modules of robots/ planner/ measure/ cell/.
+"""No import circles between the modules of robots/ planner/ measure/ cell/, nor between the
+units of cell/ (its folders and loose modules).
 
 Every module is parsed with ``ast``; imports inside functions and ``if TYPE_CHECKING`` blocks
 count too (a circle through a function-level import is still a circle of concepts).
@@ -164,7 +165,83 @@ def test_no_import_cycles() -> None:
     assert not cycles, "import cycles:\n" + "\n".join(_describe(c, graph) for c in cycles)
 
 
+def cell_unit(module: str) -> str | None:
+    """The unit of ``cell/`` a module belongs to: the folder directly under ``cell/`` that holds
+    it (``"calibration/"``) or the loose module itself (``"cli.py"``); None outside ``cell``
+    and for ``cell/__init__``."""
+    parts = module.split(".")
+    if parts[0] != "cell" or len(parts) == 1:
+        return None
+    return parts[1] + "/" if (ROOT / "cell" / parts[1]).is_dir() else parts[1] + ".py"
+
+
+def unit_graph(graph: dict[str, set[str]]) -> dict[str, set[str]]:
+    """The module graph folded onto the units of ``cell/``: an edge between two units for every
+    import between their modules (the parent-package rule of :func:`imports_of` applies)."""
+    units: dict[str, set[str]] = {}
+    for module, targets in graph.items():
+        src = cell_unit(module)
+        if src is None:
+            continue
+        units.setdefault(src, set())
+        for target in targets:
+            dst = cell_unit(target)
+            if dst is not None and dst != src:
+                units[src].add(dst)
+                units.setdefault(dst, set())
+    return units
+
+
+def _unit_evidence(component: list[str], graph: dict[str, set[str]]) -> str:
+    members = set(component)
+    lines = []
+    for module, targets in sorted(graph.items()):
+        for target in sorted(targets):
+            a, b = cell_unit(module), cell_unit(target)
+            if a in members and b in members and a != b:
+                lines.append(f"  cell/{a} -> cell/{b}: {module} imports {target}")
+    return (
+        f"{len(component)} units: "
+        + ", ".join(f"cell/{u}" for u in component)
+        + "\n"
+        + ("\n".join(lines))
+    )
+
+
+def test_unit_graph_folds_modules_onto_folders() -> None:
+    graph = {
+        "cell.run.runner": {"cell.review.store", "cell.run.setup"},
+        "cell.review.store": {"cell.run.results"},
+        "cell.run.setup": set(),
+        "cell.run.results": set(),
+        "cell.cli": {"cell.errors"},
+        "cell.errors": set(),
+    }
+    units = unit_graph(graph)
+    assert units["run/"] == {"review/"} and units["review/"] == {"run/"}
+    assert import_cycles(units) == [["review/", "run/"]]
+    assert units["cli.py"] == {"errors.py"}
+
+
+def test_no_circles_between_the_units_of_cell() -> None:
+    """Taken as units (each folder directly under ``cell/`` and each loose module there), no
+    two import each other, directly or through others: ``cell/`` is layered
+    (docs/architecture.md draws the layers)."""
+    graph = import_graph()
+    cycles = import_cycles(unit_graph(graph))
+    assert not cycles, "circles between the units of cell/:\n" + "\n".join(
+        _unit_evidence(c, graph) for c in cycles
+    )
+
+
+def test_at_most_four_loose_modules_in_cell() -> None:
+    loose = sorted(p.name for p in (ROOT / "cell").glob("*.py"))
+    assert len(loose) <= 4, loose
+
+
 if __name__ == "__main__":
     found = import_graph()
     for cycle in import_cycles(found):
         print(_describe(cycle, found))
+    for cycle in import_cycles(unit_graph(found)):
+        print(_unit_evidence(cycle, found))
