@@ -86,3 +86,41 @@ def rotation_angle(R_a: ArrayLike, R_b: ArrayLike) -> float:
     """Angle (rad) of the relative rotation between two rotation matrices."""
     R = np.asarray(R_a, dtype=float).T @ np.asarray(R_b, dtype=float)
     return float(np.arccos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+# --- SO(3): the Lie-group helpers used by the adjustments (once, here) ------------------------
+def skew(v: ArrayLike) -> Array:
+    """Cross-product matrices ``[v]x`` (..., 3, 3) of vectors ``v`` (..., 3):
+    ``[v]x @ u = v x u``."""
+    v = np.asarray(v, dtype=float)
+    S = np.zeros((*v.shape[:-1], 3, 3))
+    S[..., 0, 1], S[..., 0, 2] = -v[..., 2], v[..., 1]
+    S[..., 1, 0], S[..., 1, 2] = v[..., 2], -v[..., 0]
+    S[..., 2, 0], S[..., 2, 1] = -v[..., 1], v[..., 0]
+    return S
+
+
+def so3_exp(w: ArrayLike) -> Array:
+    """Rotation matrices (..., 3, 3) of rotation vectors ``w`` (..., 3) rad (Rodrigues)."""
+    w = np.asarray(w, dtype=float)
+    th = np.linalg.norm(w, axis=-1)[..., None, None]
+    K = skew(w / np.maximum(th[..., 0], 1e-300))
+    return np.eye(3) + np.sin(th) * K + (1.0 - np.cos(th)) * (K @ K)
+
+
+def so3_log(R: ArrayLike) -> Array:
+    """Rotation vectors (..., 3) rad of rotation matrices ``R`` (..., 3, 3)."""
+    R = np.asarray(R, dtype=float)
+    flat = R.reshape(-1, 3, 3)
+    return Rotation.from_matrix(flat).as_rotvec().reshape((*R.shape[:-2], 3))
+
+
+def so3_left_jacobian(w: ArrayLike) -> Array:
+    """Left Jacobian (3, 3) of SO(3) at the rotation vector ``w`` (rad):
+    ``exp(w + e) = exp(J_l e) exp(w)`` to first order in ``e``."""
+    w = np.asarray(w, dtype=float)
+    th = float(np.linalg.norm(w))
+    W = skew(w)
+    if th < 1e-8:
+        return np.eye(3) + 0.5 * W
+    return np.eye(3) + (1 - np.cos(th)) / th**2 * W + (th - np.sin(th)) / th**3 * W @ W

@@ -32,6 +32,7 @@ from scipy.optimize import minimize
 
 from cell.config.datums import Datum
 from cell.gdt.errors import GdtError
+from robots.transforms import skew, so3_exp
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
@@ -106,21 +107,6 @@ def kabsch(P: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     return R, t, np.sqrt(np.mean(np.sum(res**2, axis=2), axis=1))
 
 
-def _skew(a: np.ndarray) -> np.ndarray:
-    """Cross-product matrices of ``a (..., 3)``."""
-    z = np.zeros(a.shape[:-1])
-    return np.stack([np.stack([z, -a[..., 2], a[..., 1]], -1),
-                     np.stack([a[..., 2], z, -a[..., 0]], -1),
-                     np.stack([-a[..., 1], a[..., 0], z], -1)], -2)  # fmt: skip
-
-
-def _rot(w: np.ndarray) -> np.ndarray:
-    """Rotation matrices of rotation vectors ``w (N, 3)`` (Rodrigues)."""
-    th = np.linalg.norm(w, axis=1)[:, None, None]
-    K = _skew(w / np.maximum(th[:, :, 0], 1e-300))
-    return np.eye(3) + np.sin(th) * K + (1.0 - np.cos(th)) * (K @ K)
-
-
 def _minimax_step(P: np.ndarray, Q: np.ndarray, R: np.ndarray, t: np.ndarray) -> np.ndarray:
     """The small motion (rotation vector, translation; 6) from (R, t) that makes the largest
     distance of ``Q (k, 3)`` from ``R P + t`` smallest (linearised, SLSQP on the epigraph)."""
@@ -157,7 +143,7 @@ def minimax(P: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
             if worst[n] < 1e-12:
                 break
             x = _minimax_step(P, Q[n], R[n], t[n])
-            R1, t1 = _rot(x[None, :3])[0] @ R[n], t[n] + x[3:6]
+            R1, t1 = so3_exp(x[None, :3])[0] @ R[n], t[n] + x[3:6]
             w1 = _worst(P, Q[n], R1, t1)
             if w1 >= worst[n]:  # a linearised step that does not help is not taken
                 break
@@ -183,12 +169,12 @@ def rps_frame(
         p = np.einsum("nji,nkj->nki", R, d)  # DRF coordinates
         E = np.eye(3)[idx]  # (6, 3)
         ER = np.einsum("kj,nij->nki", E, R)  # rows e_a^T R^T
-        J = np.concatenate([np.einsum("nki,nkij->nkj", ER, _skew(d)), -ER], axis=2)
+        J = np.concatenate([np.einsum("nki,nkij->nkj", ER, skew(d)), -ER], axis=2)
         r = target - p[:, np.arange(len(rows)), idx]
         if np.any(np.abs(np.linalg.det(J)) < 1e-12):
             raise GdtError("rps", "the RPS points do not fix the part (singular set of axes)")
         x = np.linalg.solve(J, r[..., None])[..., 0]
-        R = _rot(x[:, :3]) @ R
+        R = so3_exp(x[:, :3]) @ R
         t = t + x[:, 3:]
     p = np.einsum("nji,nkj->nki", R, C - t[:, None, :])
     res = target - p[:, np.arange(len(rows)), idx]

@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from cell.calibration.estimate.observations import CalibrationObservations, Intrinsics
 from robots.calibration import dh_error_twists, fk_with_errors, term_names
 from robots.dh import DHTable
+from robots.transforms import skew
 
 Array = NDArray[np.float64]
 
@@ -77,15 +78,6 @@ def corrected(cam: Intrinsics, d: Array) -> Intrinsics:
     dist[: len(cam.dist)] = cam.dist
     dist[:5] += d[4:9]
     return Intrinsics(K, dist, cam.image_size)
-
-
-def _skew(v: Array) -> Array:
-    """Skew matrices (..., 3, 3) of vectors (..., 3)."""
-    S = np.zeros((*v.shape[:-1], 3, 3))
-    S[..., 0, 1], S[..., 0, 2] = -v[..., 2], v[..., 1]
-    S[..., 1, 0], S[..., 1, 2] = v[..., 2], -v[..., 0]
-    S[..., 2, 0], S[..., 2, 1] = -v[..., 1], v[..., 0]
-    return S
 
 
 def perturb_pose(T0: Array, x: Array) -> Array:
@@ -186,9 +178,9 @@ def predict(
         D = np.zeros((V, M, 3, n_cols))
         A = np.einsum("ji,vkj->vik", R_X, R_bt)  # R_X^T R_bt^T, (V, 3, 3)
         D[..., 0:3] = -R_X.T
-        D[..., 3:6] = np.einsum("ji,vmjk->vmik", R_X, _skew(y))
+        D[..., 3:6] = np.einsum("ji,vmjk->vmik", R_X, skew(y))
         D[..., 6:9] = A[:, None]
-        D[..., 9:12] = -np.einsum("vij,mjk->vmik", A, _skew(Rp))
+        D[..., 9:12] = -np.einsum("vij,mjk->vmik", A, skew(Rp))
         if kinematic:
             tw = dh_error_twists(dh, state.delta, obs.joints())  # (V, 24, 6)
             k0 = 18 if stereo else 12
@@ -198,7 +190,7 @@ def predict(
         if flange_jac:  # dX_l = -A (dp + dtheta x (P_b - p_flange))
             arm = P_b[None] - t_bt[:, None]  # (V, M, 3)
             D[..., -6:-3] = -A[:, None]
-            D[..., -3:] = np.einsum("vij,vmjk->vmik", A, _skew(arm))
+            D[..., -3:] = np.einsum("vij,vmjk->vmik", A, skew(arm))
     rows_r, rows_J, views, cams = [], [], [], []
     sides = [("left", obs.cameras.left)]
     if stereo:
@@ -218,7 +210,7 @@ def predict(
             if Ds is not None:
                 Ds = np.einsum("ji,vmjk->vmik", R_L, Ds)
                 Ds[..., 12:15] = -R_L.T
-                Ds[..., 15:18] = np.einsum("ji,vmjk->vmik", R_L, _skew(z))
+                Ds[..., 15:18] = np.einsum("ji,vmjk->vmik", R_L, skew(z))
             Xs = z @ R_L
         px, Jp, Jk = _project(Xs.reshape(-1, 3), cam, Ds is not None)
         rows_r.append((px - corners[seen].reshape(-1, 2)).reshape(-1))

@@ -55,6 +55,7 @@ from cell.calibration.estimate.result import (
 )
 from robots.calibration import structural_redundancies, term_names
 from robots.dh import DHTable
+from robots.transforms import so3_left_jacobian
 
 Array = NDArray[np.float64]
 
@@ -125,15 +126,6 @@ class CalibrationResult:
     intrinsics: dict[str, tuple[float, float]] = field(default_factory=dict)
 
 
-def _left_jacobian(w: Array) -> Array:
-    """Left Jacobian of SO(3) at rotation vector ``w``: ``exp(w + e) = exp(Jl e) exp(w)``."""
-    th = float(np.linalg.norm(w))
-    W = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
-    if th < 1e-8:
-        return np.eye(3) + 0.5 * W
-    return np.eye(3) + (1 - np.cos(th)) / th**2 * W + (th - np.sin(th)) / th**3 * W @ W
-
-
 class _Problem:
     """Residuals and Jacobian over the free columns, relative to a start state."""
 
@@ -165,7 +157,7 @@ class _Problem:
             names = [f"{prefix}.r{a}_rad" for a in "xyz"]
             if all(n in self.free for n in names):
                 k = [self.free.index(n) for n in names]
-                J[:, k] = J[:, k] @ _left_jacobian(self._x[k])
+                J[:, k] = J[:, k] @ so3_left_jacobian(self._x[k])
         return J
 
 

@@ -56,7 +56,7 @@ from planner.calibration import Candidates, choose_by_information, design_value
 from planner.calibration.select import information_factors
 from robots.calibration import dh_error_twists, fk_with_errors, structural_redundancies
 from robots.dh import DHTable
-from robots.transforms import invert
+from robots.transforms import invert, skew
 
 Array = NDArray[np.float64]
 
@@ -129,9 +129,8 @@ def point_sensitivity(dh: DHTable, state: State, q: Array, x_left: Array) -> Arr
     r = R_X @ x_left  # the point relative to the camera origin, in tool0
     P_b = np.einsum("sij,j->si", T_bt[:, :3, :3], r + t_X) + T_bt[:, :3, 3]
     H = np.zeros((len(q), 3, len(columns)))
-    skew = np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
     H[:, :, 0:3] = T_bt[:, :3, :3]  # hand-eye translation, in tool0
-    H[:, :, 3:6] = -T_bt[:, :3, :3] @ skew  # hand-eye rotation vector, in tool0
+    H[:, :, 3:6] = -T_bt[:, :3, :3] @ skew(r)  # hand-eye rotation vector, in tool0
     tw = dh_error_twists(dh, state.delta, q)  # (S, 24, 6)
     moved = tw[:, :, :3] + np.cross(tw[:, :, 3:], P_b[:, None, :])  # (S, 24, 3)
     k0 = columns.index("dh.a1_m")

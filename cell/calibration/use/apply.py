@@ -15,12 +15,9 @@ from numpy.typing import ArrayLike, NDArray
 from cell.calibration.estimate.result import CellCalibration
 from robots.calibration import calibrated_table, dh_error_twists, fk_with_errors, term_names
 from robots.dh import DHTable, fk_dh
+from robots.transforms import skew
 
 Array = NDArray[np.float64]
-
-
-def _skew(v: Array) -> Array:
-    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
 
 
 class CalibratedKinematics:
@@ -80,7 +77,7 @@ class CalibratedKinematics:
         cols: dict[str, Array] = {}
         for k, axis in enumerate(("x_m", "y_m", "z_m")):
             cols[f"T_tool0_camera.{axis}"] = R_bt[:, k]
-        rot = -R_bt @ _skew(X[:3, :3] @ p_c)
+        rot = -R_bt @ skew(X[:3, :3] @ p_c)
         for k, axis in enumerate(("rx_rad", "ry_rad", "rz_rad")):
             cols[f"T_tool0_camera.{axis}"] = rot[:, k]
         if cal.dh_terms:
@@ -92,7 +89,7 @@ class CalibratedKinematics:
             cols = {k: R_Y.T @ v for k, v in cols.items()}
             for k, axis in enumerate(("x_m", "y_m", "z_m")):
                 cols[f"T_base_target.{axis}"] = -R_Y.T[:, k]
-            rot_t = R_Y.T @ _skew(p_b - t_Y)
+            rot_t = R_Y.T @ skew(p_b - t_Y)
             for k, axis in enumerate(("rx_rad", "ry_rad", "rz_rad")):
                 cols[f"T_base_target.{axis}"] = rot_t[:, k]
         J = np.zeros((3, len(cal.parameter_names)))
