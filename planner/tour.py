@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from planner.errors import TourFileError
+from robots.files import write_text_atomic
 
 FORMAT = "holecell.tour"
 FORMAT_VERSION = 1
@@ -126,11 +127,7 @@ def pose_dict(T: NDArray[np.float64]) -> dict[str, list[float]]:
 def write_json(path: str | Path, data: dict[str, Any]) -> Path:
     """Write ``data`` as JSON to ``path`` via a temporary name beside it (an existing file is
     never half-written); returns the path."""
-    target = Path(path)
-    tmp = target.with_name(target.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=1))
-    tmp.replace(target)
-    return target
+    return write_text_atomic(path, json.dumps(data, indent=1))
 
 
 def read_json_object(path: str | Path) -> dict[str, Any]:

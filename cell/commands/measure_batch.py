@@ -36,6 +36,7 @@ from cell.commands.run_progress import bar
 from cell.errors import CellError
 from measure import MeasureOptions, StereoCalibration, measure_hole
 from measure.image_input import read_image
+from robots.files import write_text_atomic
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm")
 _SIDE = re.compile(
@@ -256,9 +257,7 @@ def run_batch(args: argparse.Namespace) -> int:
     if args.output:
         out = Path(args.output)
         text = to_json(rows, args.stereo) if out.suffix.lower() == ".json" else to_csv(rows)
-        tmp = out.with_name(out.name + ".tmp")
-        tmp.write_text(text)
-        tmp.replace(out)
+        write_text_atomic(out, text)
     if args.json:
         print(to_json(rows, args.stereo), end="")
     else:

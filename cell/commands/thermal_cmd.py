@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -24,6 +23,7 @@ from cell.commands.argtypes import output_file
 from cell.commands.group_help import help_handler
 from robots.dh import DHTable
 from robots.dh_models import dh_table
+from robots.files import write_text_atomic
 from robots.models import MODELS
 from robots.thermal import (
     CellGeometry,
@@ -181,12 +181,6 @@ def _print_result(res: IdentificationResult, source: Path) -> None:
     )
 
 
-def _write_atomic(path: Path, write) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    write(tmp)
-    os.replace(tmp, path)
-
-
 def run_identify(args: argparse.Namespace) -> int:
     """Identify the model from the observations and write thermal.json."""
     from cell.config import load_cell
@@ -202,7 +196,7 @@ def run_identify(args: argparse.Namespace) -> int:
     options = IdentifyOptions(max_condition=args.max_condition)
     res = identify(obs, geometry, table, spec, options, robot_model=model_name)
     _print_result(res, args.observations)
-    _write_atomic(args.output, lambda p: save_model(p, res.model))
+    save_model(args.output, res.model)
     print(f"wrote {args.output}")
     return 0
 
@@ -255,7 +249,7 @@ def run_predict(args: argparse.Namespace) -> int:
             extra += [repr(float(v)) for v in cmds[i].q_rad] + [cmds[i].status]
         w.writerow(list(row) + extra)
     if args.output:
-        _write_atomic(args.output, lambda path: path.write_text(buf.getvalue(), encoding="utf-8"))
+        write_text_atomic(args.output, buf.getvalue())
         print(f"wrote {len(poses.rows)} rows to {args.output}", file=sys.stderr)
     else:
         sys.stdout.write(buf.getvalue())
@@ -294,7 +288,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         noise_m=args.noise_um * 1e-6,
         seed=args.seed,
     )
-    _write_atomic(args.output, lambda p: write_observations(p, obs))
+    write_observations(args.output, obs)
     print(
         f"wrote {len(obs)} observations ({len(poses)} poses x {len(times)} times) to {args.output}"
     )

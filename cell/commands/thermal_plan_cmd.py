@@ -16,7 +16,6 @@ import argparse
 import csv
 import io
 import math
-import os
 from dataclasses import replace
 from pathlib import Path
 
@@ -29,6 +28,7 @@ from cell.errors import CellError
 from cell.run.reference import design_reference_plan, fixed_reference_plan
 from cell.run.target_suggest import suggest_targets
 from planner import load_tour
+from robots.files import write_text_atomic
 from robots.thermal.design import Design, DesignOptions, evaluate
 from robots.thermal.errors import ThermalError
 
@@ -117,9 +117,7 @@ def write_views(path: Path, design: Design) -> None:
     for k, v in enumerate(design.views):
         w.writerow([k, v.target_id, *(repr(float(x)) for x in v.q_rad), repr(v.tilt_rad),
                     repr(v.azimuth_rad)])  # fmt: skip
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(buf.getvalue(), encoding="utf-8")
-    os.replace(tmp, path)
+    write_text_atomic(path, buf.getvalue())
 
 
 def read_views(path: Path, cell: CellConfig) -> list[tuple[str, np.ndarray]]:

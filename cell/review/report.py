@@ -29,6 +29,7 @@ from cell.review.report_html import render_html
 from cell.review.store import Store
 from cell.uncertainty.budget import COMPONENTS
 from cell.uncertainty.decision import CONFORMING, INCONCLUSIVE, NONCONFORMING
+from robots.files import write_text_atomic
 
 CSV_COLUMNS = (
     "hole_id", "stop", "status",
@@ -138,7 +139,7 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
     gdt, results = report_evaluation(info, results, rows, summ)  # cell.gdt, docs/gdt.md
     html = render_html(summ, info, results, planned, operator, reference,
                        gdt_section(gdt.fields()), gdt.alignment == "fixture")  # fmt: skip
-    _atomic_write(run_dir / "report.html", html)
+    write_text_atomic(run_dir / "report.html", html)
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events, **gdt.fields()}  # fmt: skip
     (run_dir / "report.json").write_text(json.dumps(doc, indent=1))
@@ -149,12 +150,6 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
             w.writerow({k: ("" if v is None else v) for k, v in row.items()})
     write_run_qif(doc, run_dir, info, results)  # QIF 3.0 results (cell.review.qif)
     return summ
-
-
-def _atomic_write(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
 
 
 def format_summary(summ: dict[str, Any]) -> str:

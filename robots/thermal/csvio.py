@@ -16,6 +16,7 @@ message naming the column and the unit expected.
 from __future__ import annotations
 
 import csv
+import io
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +24,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from robots.files import write_text_atomic
 from robots.thermal.errors import ThermalDataError
 from robots.thermal.observations import Observations
 
@@ -185,18 +187,19 @@ def read_observations(path: str | Path, known_targets: set[str] | None = None) -
 
 
 def write_observations(path: str | Path, obs: Observations) -> None:
-    """Write observations in the CSV format :func:`read_observations` reads."""
+    """Write observations in the CSV format :func:`read_observations` reads (atomically)."""
     temp_cols = [f"temp_{n}_degC" for n in obs.sensor_names]
-    with Path(path).open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(["time_s", "target_id", *JOINT_COLUMNS, *temp_cols, *POSITION_COLUMNS])
-        for i in range(len(obs)):
-            w.writerow(
-                [repr(float(obs.time_s[i])), obs.target_ids[i]]
-                + [repr(float(v)) for v in obs.q_rad[i]]
-                + [repr(float(v)) for v in obs.temps_degC[i]]
-                + [repr(float(v)) for v in obs.p_tcp_m[i]]
-            )
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(["time_s", "target_id", *JOINT_COLUMNS, *temp_cols, *POSITION_COLUMNS])
+    for i in range(len(obs)):
+        w.writerow(
+            [repr(float(obs.time_s[i])), obs.target_ids[i]]
+            + [repr(float(v)) for v in obs.q_rad[i]]
+            + [repr(float(v)) for v in obs.temps_degC[i]]
+            + [repr(float(v)) for v in obs.p_tcp_m[i]]
+        )
+    write_text_atomic(path, buf.getvalue())
 
 
 def read_poses(

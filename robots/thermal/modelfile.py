@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from robots.dh import DHTable
+from robots.files import write_text_atomic
 from robots.thermal.errors import ThermalError, ThermalModelFileError
 from robots.thermal.model import TERM_UNIT, ThermalModel, ThermalSpec, term_kind_and_link
 from robots.transforms import matrix_to_pose, pose_to_matrix
@@ -94,7 +95,7 @@ def model_to_dict(model: ThermalModel) -> dict[str, Any]:
 def save_model(path: str | Path, model: ThermalModel) -> None:
     """Write ``thermal.json`` (NaN uncertainties become null)."""
     text = json.dumps(model_to_dict(model), indent=2)
-    Path(path).write_text(text.replace("NaN", "null") + "\n", encoding="utf-8")
+    write_text_atomic(path, text.replace("NaN", "null") + "\n")
 
 
 def _get(doc: dict[str, Any], path: str, src: str) -> Any:

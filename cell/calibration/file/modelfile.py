@@ -29,6 +29,7 @@ from cell.calibration.estimate.result import (
 )
 from robots.calibration import term_names
 from robots.dh import DHTable
+from robots.files import write_text_atomic
 
 #: a calibration older than this is refused by :func:`check_age` by default (days): an arm's
 #: geometry and a head's mount are re-checked monthly in a production cell
@@ -115,10 +116,7 @@ def calibration_to_dict(cal: CellCalibration) -> dict[str, Any]:
 
 def save_calibration(cal: CellCalibration, path: str | Path) -> None:
     """Write ``cellcal.json`` (a temporary file renamed over the target)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(calibration_to_dict(cal), indent=1) + "\n")
-    tmp.replace(path)
+    write_text_atomic(path, json.dumps(calibration_to_dict(cal), indent=1) + "\n")
 
 
 class _Reader:

@@ -42,6 +42,7 @@ from measure.synth.heads import toed_in_stereo
 from measure.synth.targets import render_target_pair
 from measure.target import TargetSpec
 from robots.calibration import fk_with_errors, term_names
+from robots.files import write_text_atomic
 
 Array = NDArray[np.float64]
 
@@ -121,7 +122,7 @@ def _write_truth(path: Path, truth: SyntheticTruth, joints: bool) -> None:
         doc["dh_errors"] = dict(zip(term_names(), map(float, g.delta), strict=True))
     if g.T_left_right is not None:
         doc["T_left_right"] = np.asarray(g.T_left_right).tolist()
-    path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+    write_text_atomic(path, json.dumps(doc, indent=1) + "\n")
 
 
 def write_example_set(
