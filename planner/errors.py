@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections import Counter
+
 
 class PlanningError(Exception):
     """Base of every error raised by :mod:`planner`. The CLI prints its message, no traceback."""
@@ -108,3 +110,13 @@ class StartsFailedError(PlanningError):
     def __init__(self, messages: list[str]) -> None:
         self.messages = list(messages)
         super().__init__(self.messages[0] if self.messages else "no start was run")
+
+
+class NoCalibrationViewError(PlanningError):
+    """No pose of the arm shows the board to both cameras; ``reasons`` counts why not."""
+
+    def __init__(self, board: str, reasons: dict[str, int]) -> None:
+        self.board = board
+        self.reasons = dict(reasons)
+        listed = ", ".join(f"{why} ({n})" for why, n in Counter(reasons).most_common())
+        super().__init__(f"{board}: no feasible calibration view: {listed or 'no pose tried'}")

@@ -82,3 +82,12 @@ class DHFormError(RobotModelError):
         self.joint = joint
         self.reason = reason
         super().__init__(f"{joint}: {reason}")
+
+
+class MeshFileError(RobotModelError):
+    """A mesh file is missing, unreadable or holds no triangles."""
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"{path}: {reason}")

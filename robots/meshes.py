@@ -15,19 +15,10 @@ import coal
 import numpy as np
 from numpy.typing import NDArray
 
-from robots.errors import RobotModelError
+from robots.errors import MeshFileError
 
 #: mesh files read for mesh obstacles (trimesh); URDF link meshes also take .dae (assimp)
 MESH_SUFFIXES = (".stl", ".obj", ".ply")
-
-
-class MeshFileError(RobotModelError):
-    """A mesh file is missing, unreadable or holds no triangles."""
-
-    def __init__(self, path: str, reason: str) -> None:
-        self.path = path
-        self.reason = reason
-        super().__init__(f"{path}: {reason}")
 
 
 @dataclass(frozen=True, eq=False)

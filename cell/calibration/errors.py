@@ -33,3 +33,15 @@ class CalibrationFileError(CellError):
         self.field = field
         self.reason = reason
         super().__init__(f"{path}: {field}: {reason}")
+
+
+class TargetNotFoundError(CalibrationDataError):
+    """One image does not show the (whole, sharp) target; the image itself could be read."""
+
+
+class StopCorrectionError(CellError):
+    """A stop cannot be corrected for the calibration (limits, no convergence)."""
+
+    def __init__(self, where: str, stop: int, hole_id: str, reason: str) -> None:
+        self.stop, self.hole_id, self.reason = stop, hole_id, reason
+        super().__init__(f"{where}: stop {stop} ({hole_id}): {reason}")

@@ -16,7 +16,7 @@ import argparse
 import importlib
 
 from cell.commands import calibrate_stereo_cmd
-from cell.errors import CellError
+from cell.commands.errors import CalibrateUsageError
 
 #: the ``calibrate`` subcommands' modules under ``cell.commands``, in ``--help`` order
 CALIBRATE_MODULES: tuple[str, ...] = (
@@ -25,10 +25,6 @@ CALIBRATE_MODULES: tuple[str, ...] = (
     "calibrate_cell_cmd",
     "calibrate_example_cmd",
 )
-
-
-class CalibrateUsageError(CellError):
-    """``holecell calibrate`` without a subcommand and without the old form's options."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from cell.review.spc.collect import SpcError, read_runs, series
+from cell.review.spc.collect import read_runs, series
+from cell.review.spc.errors import SpcError
 from cell.review.spc.write import Analysis, analyse, write_spc
 
 

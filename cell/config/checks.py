@@ -11,7 +11,7 @@ import numpy as np
 
 from cell.config.target import read_corners
 from robots import LimitsError, RobotModelError
-from robots.meshes import MeshFileError
+from robots.errors import MeshFileError
 
 if TYPE_CHECKING:
     from cell.config.schema import CellConfig

@@ -30,11 +30,11 @@ from typing import Any
 import numpy as np
 
 from cell.records.hole_result import HoleResult
+from cell.review.errors import StoreError
 from cell.review.store_file import (
     FILENAME,
     READABLE_VERSIONS,
     SCHEMA_VERSION,
-    StoreError,
     checked_version,
     connect,
     count_measurements,

@@ -12,7 +12,7 @@ import sqlite3
 from pathlib import Path
 from typing import Any
 
-from cell.errors import CellError
+from cell.review.errors import StoreError
 
 SCHEMA_VERSION = 3
 #: versions :meth:`Store.open` can read; older ones get the tables added since (nothing removed)
@@ -64,15 +64,6 @@ CREATE TABLE IF NOT EXISTS uncertainty (
 )
 #: the tables added by schema versions 2 and 3
 _SCHEMA_V2 = _SCHEMA[_SCHEMA.index("CREATE TABLE IF NOT EXISTS reference_observations") :]
-
-
-class StoreError(CellError):
-    """The store cannot be created or used (exists already, corrupt, foreign, duplicate hole)."""
-
-    def __init__(self, path: str | Path, reason: str) -> None:
-        self.path = str(path)
-        self.reason = reason
-        super().__init__(f"{path}: {reason}")
 
 
 def create_file(

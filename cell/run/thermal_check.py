@@ -11,24 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from cell.errors import CellError
+from cell.run.errors import ThermalModelMismatchError
 from robots import Arm
 from robots.thermal.model import ThermalModel
 
 #: agreement of lengths (m) and of rotation-matrix and angle entries (rad) after a file round trip
 ATOL = 1e-9
-
-
-class ThermalModelMismatchError(CellError):
-    """A thermal model file was made for another cell, arm, tool or sensor set."""
-
-    def __init__(self, where: str, field: str, model_value: object, cell_value: object) -> None:
-        self.where, self.field = where, field
-        super().__init__(
-            f"{where}: {field} is {model_value} in the thermal model but {cell_value} in the "
-            "cell: identify a model for this cell (holecell thermal identify) or run without "
-            "--thermal"
-        )
 
 
 def _fmt(a: np.ndarray) -> str:

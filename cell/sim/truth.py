@@ -48,7 +48,7 @@ from scipy.spatial.transform import Rotation
 
 from cell.config import CellConfig
 from cell.errors import TruthFileError
-from cell.sim.truth_file import FORMAT, TruthSpec, read_truth_spec
+from cell.sim.truth_file import FORMAT, FORMAT_VERSION, TruthSpec, read_truth_spec
 from cell.uncertainty.repeatability import repeatability_rp_m
 from robots import DEFAULT_MODEL
 from robots.dh import DHTable
@@ -194,6 +194,7 @@ class CellTruth:
         """The truth file's content (every field written)."""
         return {
             "format": FORMAT,
+            "version": FORMAT_VERSION,
             "seed": self.seed,
             "robot": {
                 "dh_errors": [

@@ -19,8 +19,11 @@ from cell.config.problems import pydantic_problems
 from cell.config.yaml_problem import yaml_problem
 from cell.errors import NO_VALUE, TruthFileError
 
-#: the truth file's format tag (optional in a file; written first)
-FORMAT = "holecell.truth/1"
+#: the truth file's format tag and version (optional in a file; written first)
+FORMAT = "holecell.truth"
+FORMAT_VERSION = 1
+#: the tag of files written before format + version (still read)
+LEGACY_FORMAT = "holecell.truth/1"
 #: largest D-H length error (m) and angle error (rad) a truth file may state
 MAX_DH_LENGTH_ERROR_M = 0.01
 MAX_DH_ANGLE_ERROR_RAD = 0.05
@@ -99,7 +102,8 @@ class StereoTruth(_Strict):
 class TruthSpec(_Strict):
     """A whole truth file (every key optional)."""
 
-    format: Literal["holecell.truth/1"] | None = None
+    format: Literal["holecell.truth", "holecell.truth/1"] | None = None
+    version: Literal[1] | None = None
     seed: Annotated[int, Field(ge=0, lt=2**63)] | None = None
     robot: RobotTruth = RobotTruth()
     tool: ToolTruth = ToolTruth()

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cell.errors import CellError
+from cell.uncertainty.errors import PartTemperatureError
 from cell.uncertainty.materials import Material
 
 #: ISO 1 reference temperature (degC)
@@ -35,14 +35,6 @@ DEFAULT_READING_U_K = 0.2
 RANGE_C = (-10.0, 50.0)
 #: standard uncertainty of the cell file's part.temperature_c given without one (K): a room figure
 CELL_FILE_U_K = 1.0
-
-
-class PartTemperatureError(CellError):
-    """A part temperature reading that cannot be right (names where it came from)."""
-
-    def __init__(self, source: str, value: object, reason: str) -> None:
-        self.source, self.value, self.reason = source, value, reason
-        super().__init__(f"{source}: {reason} (value: {value!r})")
 
 
 @dataclass(frozen=True)

@@ -10,12 +10,7 @@ GTSP, OMPL and ruckig machinery; :class:`CalibrationTour` is ``caltour.json``. I
 """
 
 from planner.calibration.board import Board, Projector, StereoModel
-from planner.calibration.candidates import (
-    CandidateOptions,
-    Candidates,
-    NoCalibrationViewError,
-    candidate_views,
-)
+from planner.calibration.candidates import CandidateOptions, Candidates, candidate_views
 from planner.calibration.select import (
     GeometryScore,
     PreselectOptions,
@@ -33,6 +28,7 @@ from planner.calibration.tour import (
     view_ids,
     view_metadata,
 )
+from planner.errors import NoCalibrationViewError
 
 __all__ = [
     "Board",

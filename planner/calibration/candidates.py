@@ -34,21 +34,11 @@ from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
 from planner.calibration.board import Board, StereoModel
-from planner.errors import PlanningError
+from planner.errors import NoCalibrationViewError, PlanningError
 from planner.protocols import ArmLike
 from robots.transforms import invert
 
 log = logging.getLogger(__name__)
-
-
-class NoCalibrationViewError(PlanningError):
-    """No pose of the arm shows the board to both cameras; ``reasons`` counts why not."""
-
-    def __init__(self, board: str, reasons: dict[str, int]) -> None:
-        self.board = board
-        self.reasons = dict(reasons)
-        listed = ", ".join(f"{why} ({n})" for why, n in Counter(reasons).most_common())
-        super().__init__(f"{board}: no feasible calibration view: {listed or 'no pose tried'}")
 
 
 @dataclass(frozen=True)

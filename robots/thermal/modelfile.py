@@ -2,7 +2,7 @@
 
 Layout (SI units; temperatures in degC)::
 
-    {"format": "holecell.thermal/1", "robot_model": "abb_irb2600_20_165",
+    {"format": "holecell.thermal", "version": 1, "robot_model": "abb_irb2600_20_165",
      "dh": {"a_m": [...6], "d_m": [...6], "alpha_rad": [...6], "theta_offset_rad": [...6]},
             (and "joint_sign": [...6] of +1/-1 when a joint turns about -z_{i-1}, e.g. KUKA's J1)
      "sensors": {"names": ["j1", ...], "reference_degC": [...], "link_sensors": [...6 names]},
@@ -35,7 +35,10 @@ from robots.thermal.errors import ThermalError, ThermalModelFileError
 from robots.thermal.model import TERM_UNIT, ThermalModel, ThermalSpec, term_kind_and_link
 from robots.transforms import matrix_to_pose, pose_to_matrix
 
-FORMAT = "holecell.thermal/1"
+FORMAT = "holecell.thermal"
+FORMAT_VERSION = 1
+#: the tag of files written before format + version (still read)
+LEGACY_FORMAT = "holecell.thermal/1"
 
 
 def model_to_dict(model: ThermalModel) -> dict[str, Any]:
@@ -49,6 +52,7 @@ def model_to_dict(model: ThermalModel) -> dict[str, Any]:
 
     return {
         "format": FORMAT,
+        "version": FORMAT_VERSION,
         "robot_model": model.robot_model,
         "dh": {
             "a_m": a.tolist(),
@@ -165,9 +169,15 @@ def _row(row: Any, i: int, n: int, src: str) -> list[float]:
 
 def model_from_dict(doc: Any, src: str = "thermal.json") -> ThermalModel:
     """A model from its JSON description; raises :class:`ThermalModelFileError` naming the field."""
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+    if not isinstance(doc, dict) or doc.get("format") not in (FORMAT, LEGACY_FORMAT):
         found = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
         raise ThermalModelFileError(src, "format", f"expected {FORMAT!r}, found {found!r}")
+    if doc["format"] == FORMAT and doc.get("version") != FORMAT_VERSION:
+        raise ThermalModelFileError(
+            src,
+            "version",
+            f"this holecell reads version {FORMAT_VERSION}, found {doc.get('version')!r}",
+        )
     rows = ("a_m", "d_m", "alpha_rad", "theta_offset_rad")
     table = DHTable(*(tuple(_vector(doc, f"dh.{k}", src, 6)) for k in rows))
     if "joint_sign" in _get(doc, "dh", src):  # written only for arms with a -1

@@ -46,7 +46,7 @@ def test_written_and_read_back(solved, tmp_path: Path) -> None:
     assert back.flange_scatter == cal.flange_scatter and "source" in back.flange_scatter
     assert [t.reason for t in back.dh_terms] == [t.reason for t in cal.dh_terms]
     data = json.loads(path.read_text())
-    assert data["format"] == "holecell.cellcal" and data["schema_version"] == 1
+    assert data["format"] == "holecell.cellcal" and data["version"] == 1
     assert set(data["T_tool0_camera"]) >= {"xyz", "quat_xyzw", "covariance"}
     assert data["residuals"]["rms_px"]["right"] > 0 and len(data["residuals"]["views"]) == 12
     fixed = [e for e in data["dh"]["errors"] if not e["free"]]
@@ -64,7 +64,7 @@ def _broken(cal, edit) -> dict:
     [
         (lambda d: d["T_tool0_camera"].pop("xyz"), "T_tool0_camera.xyz: missing"),
         (lambda d: d["T_tool0_camera"].update(quat_xyzw=[0, 0, 0, 2]), "T_tool0_camera.quat_xyzw"),
-        (lambda d: d.update(schema_version=2), "schema_version"),
+        (lambda d: d.update(version=2), "version"),
         (lambda d: d.update(format="thermal"), "format"),
         (lambda d: d["T_base_target"]["covariance"][0].__setitem__(1, 1.0), "not symmetric"),
         (lambda d: d["dh"]["errors"][3].update(name="d1_m"), "dh.errors[3].name"),
@@ -137,3 +137,12 @@ def test_the_point_covariance_is_the_spread_of_sampled_calibrations(solved, fram
     assert np.allclose(np.sqrt(np.diag(emp)), np.sqrt(np.diag(pred)), rtol=0.1)
     with pytest.raises(ValueError, match="frame"):
         ck.point_covariance(q, p_c, frame="cell")
+
+
+def test_a_file_with_the_old_version_key_is_still_read(solved, tmp_path: Path) -> None:
+    _tr, cal = solved
+    data = calibration_to_dict(cal)
+    data["schema_version"] = data.pop("version")  # as written before Dec 2026
+    path = tmp_path / "cellcal.json"
+    path.write_text(json.dumps(data))
+    assert load_calibration(path).parameter_names == cal.parameter_names

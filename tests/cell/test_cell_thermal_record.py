@@ -59,7 +59,7 @@ def test_observations_and_model_are_stored_and_reloaded(
         assert cold is not None and len(cold) == 6
         assert json.loads(text)["sensors"]["reference_degC"] == list(cold)
         assert n_obs >= 2 * len(small_cell.reference.stops) - 2
-        assert "identified" in source and json.loads(text)["format"] == "holecell.thermal/1"
+        assert "identified" in source and json.loads(text)["format"] == "holecell.thermal"
         # resumed without reference rounds: the stored model compensates the next hole
         _interrupted(small_cell, tmp_path, sim, 0, True)
         # one more round: identified from the stored rows and the new ones together

@@ -139,6 +139,13 @@ def test_model_file_round_trip_and_errors(tmp_path, table, cell, obs):
     temps = np.full(6, 30.0)
     assert np.allclose(back.fk(q, temps), model.fk(q, temps), atol=1e-14)
     doc = json.loads(path.read_text())
+    assert (doc["format"], doc["version"]) == ("holecell.thermal", 1)
+    legacy = {k: v for k, v in doc.items() if k != "version"} | {"format": "holecell.thermal/1"}
+    path.write_text(json.dumps(legacy))  # as written before Dec 2026: still read
+    assert load_model(path).coefficients == model.coefficients
+    path.write_text(json.dumps(doc | {"version": 2}))
+    with pytest.raises(ThermalModelFileError, match="version"):
+        load_model(path)
     doc["coefficients"]["k_link2"]["value"] = "hot"
     path.write_text(json.dumps(doc))
     with pytest.raises(ThermalModelFileError, match=r"coefficients\.k_link2"):

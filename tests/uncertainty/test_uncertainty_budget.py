@@ -18,8 +18,9 @@ from cell.uncertainty.calibration import (
     monte_carlo_covariance,
 )
 from cell.uncertainty.decision import decide_hole, decide_one
+from cell.uncertainty.errors import PartTemperatureError
 from cell.uncertainty.materials import Material
-from cell.uncertainty.part_temperature import PartTemperatureError, PartThermalState, part_state
+from cell.uncertainty.part_temperature import PartThermalState, part_state
 from cell.uncertainty.repeatability import RP_PER_SIGMA, repeatability_rp_m, sigma_per_axis_m
 from measure import measure_hole
 from measure.synth import render_hole_pair, standard_stereo

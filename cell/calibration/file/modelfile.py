@@ -71,7 +71,7 @@ def calibration_to_dict(cal: CellCalibration) -> dict[str, Any]:
     pv = cal.provenance
     return {
         "format": FORMAT,
-        "schema_version": SCHEMA_VERSION,
+        "version": SCHEMA_VERSION,
         "created_utc": cal.created_utc,
         "robot": {"model": pv.robot_model, "fingerprint": pv.robot_fingerprint},
         "tool": {"fingerprint": pv.tool_fingerprint},
@@ -200,11 +200,10 @@ def calibration_from_dict(data: Any, path: str = "<memory>") -> CellCalibration:
         raise r.fail("<root>", "must be a JSON object")
     if r.get(data, "format", "format", str) != FORMAT:
         raise r.fail("format", f"must be {FORMAT!r}, got {data['format']!r}")
-    version = r.get(data, "schema_version", "schema_version", int)
+    key = "version" if "version" in data or "schema_version" not in data else "schema_version"
+    version = r.get(data, key, key, int)  # "schema_version": files written before Dec 2026
     if version != SCHEMA_VERSION:
-        raise r.fail(
-            "schema_version", f"this holecell reads version {SCHEMA_VERSION}, got {version}"
-        )
+        raise r.fail(key, f"this holecell reads version {SCHEMA_VERSION}, got {version}")
     created = r.get(data, "created_utc", "created_utc", str)
     try:
         datetime.strptime(created, "%Y-%m-%dT%H:%M:%SZ")

@@ -17,7 +17,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from cell.calibration.errors import CalibrationDataError
+from cell.calibration.errors import CalibrationDataError, TargetNotFoundError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
 from cell.calibration.inputs.posecsv import PoseRow
 from measure.target import MAX_EDGE_WIDTH_PX, TargetSpec, find_target
@@ -53,10 +53,6 @@ def _corners(
     if det.points is None:
         raise TargetNotFoundError(src, f"image {path.name}: {det.reason}", row)
     return det.points
-
-
-class TargetNotFoundError(CalibrationDataError):
-    """One image does not show the (whole, sharp) target; the image itself could be read."""
 
 
 def board_size_hint(spec: TargetSpec) -> str:

@@ -4,8 +4,9 @@ stops corrected so the calibrated head reaches the planned viewpoints (:mod:`.co
 
 from __future__ import annotations
 
+from cell.calibration.errors import StopCorrectionError
 from cell.calibration.use.apply import CalibratedKinematics
-from cell.calibration.use.corrected_tour import StopCorrectionError, correct_tour
+from cell.calibration.use.corrected_tour import correct_tour
 from cell.calibration.use.run_calibration import (
     MAX_AGE_DAYS,
     RUN_FILENAME,

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from cell.calibration.errors import StopCorrectionError
 from cell.calibration.use.run_calibration import RunGeometry
 from cell.errors import CellError
 from planner import Tour
@@ -36,14 +37,6 @@ Array = NDArray[np.float64]
 #: a corrected stop must reach its goal this closely (m, rad)
 POSITION_TOL_M = 1e-9
 ROTATION_TOL_RAD = 1e-9
-
-
-class StopCorrectionError(CellError):
-    """A stop cannot be corrected for the calibration (limits, no convergence)."""
-
-    def __init__(self, where: str, stop: int, hole_id: str, reason: str) -> None:
-        self.stop, self.hole_id, self.reason = stop, hole_id, reason
-        super().__init__(f"{where}: stop {stop} ({hole_id}): {reason}")
 
 
 @dataclass(frozen=True)

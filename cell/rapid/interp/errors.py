@@ -3,9 +3,12 @@ time (an ``ERRNO`` the module's ``ERROR`` handlers see) and a program stopped by
 
 from __future__ import annotations
 
+from cell.errors import CellError
 
-class RapidError(Exception):
-    """Base of the interpreter's errors; ``line`` is the module line (1-based, 0: none)."""
+
+class RapidError(CellError):
+    """Base of the interpreter's errors (a :class:`cell.errors.CellError`: the CLI prints it as
+    one line); ``line`` is the module line (1-based, 0: none)."""
 
     def __init__(self, text: str, line: int = 0, source: str = "") -> None:
         self.text, self.line, self.source = text, line, source

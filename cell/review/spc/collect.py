@@ -14,12 +14,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from cell.errors import CellError
 from cell.review.qif.read import CharacteristicResult, QifResults, read_qif
-
-
-class SpcError(CellError):
-    """The runs of an SPC study cannot be used; the message names the path or characteristic."""
+from cell.review.spc.errors import SpcError
 
 
 @dataclass(frozen=True)
