@@ -23,6 +23,7 @@ test: $(STAMP)
 lint: $(STAMP)
 	$(VENV)/bin/ruff check cell planner measure robots tests benchmarks examples
 	$(VENV)/bin/ruff format --check cell planner measure robots tests benchmarks examples
+	$(VENV)/bin/mypy
 
 format: $(STAMP)
 	$(VENV)/bin/ruff format cell planner measure robots tests benchmarks examples

@@ -56,6 +56,10 @@ class SegmentPlanningError(PlanningError):
     ``hole_a`` and ``hole_b`` are hole ids, or ``"home"`` for the home configuration.
     """
 
+    #: the two candidate nodes of the motion, set by the planner when it knows them
+    #: (declared only: read with ``getattr(exc, "nodes", None)``)
+    nodes: tuple[int, int] | None
+
     def __init__(self, hole_a: str, hole_b: str, reason: str) -> None:
         self.hole_a = hole_a
         self.hole_b = hole_b

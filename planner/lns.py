@@ -173,8 +173,9 @@ class GtspLns:
                 perm = self.k.improve_path(self.G, np.array(path), MAX_MOVES).tolist()
             else:
                 holes = np.array(order, dtype=np.int64)
+                G = np.asarray(self.G, dtype=np.float64)  # compiled: already float64, no copy
                 perm = self.kn.improve_path_near(
-                    self.G, np.array(path), holes, self.near, MAX_MOVES
+                    G, np.array(path), holes, self.near, MAX_MOVES
                 ).tolist()
             inner = [p - 1 for p in perm[1:-1]]
             o2, n2, c2 = self._rechoose([order[p] for p in inner])
@@ -218,8 +219,8 @@ class GtspLns:
     ) -> tuple[list[int], list[int]]:
         """Each removed hole, in turn, at its cheapest position with its cheapest node."""
         if self.k is not None:
-            args = (self.G, np.array(order), np.array(nodes), np.array(removed))
-            args += (self.gnodes, self.goff)
+            G = np.asarray(self.G, dtype=np.float64)  # compiled: already float64, no copy
+            args = (G, np.array(order), np.array(nodes), np.array(removed), self.gnodes, self.goff)
             o, v = (
                 self.k.insert(*args) if self.near is None else self.kn.insert_near(*args, self.near)
             )

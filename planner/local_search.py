@@ -95,8 +95,8 @@ def improve_order(C: NDArray[np.float64], max_moves: int = 10_000) -> list[int]:
         if kind == "2opt":
             step = apply_two_opt(step, *args)
         else:
-            i, length, j, rev = args
-            step = apply_or_opt(step, i, length, j, bool(rev))
+            i, length, j, rev_flag = args
+            step = apply_or_opt(step, i, length, j, bool(rev_flag))
         perm = [perm[s] for s in step]
         cur = cur[np.ix_(step, step)]
     return perm

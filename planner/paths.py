@@ -268,6 +268,7 @@ class SegmentPlanner:
         """
         if straight_free or self.checker.segment_free(q_a, q_b):
             return SegmentPath(np.array([q_a, q_b]), planned=False)
+        Q: NDArray[np.float64] | None
         if via is not None and len(via):
             Q = np.vstack([q_a, via, q_b])
             if self.checker.polyline_free(Q):

@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -160,6 +161,7 @@ class TourPlanner(LazyEdgeChecks):
             via = None
             known = False  # checked free at the set resolution by the lazy rounds' batch
             if path is not None:
+                assert seqr is not None  # path is only built with a sequencer (above)
                 hops = self._roadmap.via(path[k], path[k + 1])
                 via = None if not hops else seqr.nodes[hops]
                 u, v = path[k], path[k + 1]
@@ -211,7 +213,9 @@ class TourPlanner(LazyEdgeChecks):
         self._corridor = 0
         seqr = shared.sequencer
         if self.sequencer is not None or seqr is None:
-            res = self.sequencer(home, cands, limits)
+            # None only for a shared plan prepared with a replacement sequencer (the options
+            # do not record it): the call then fails as it always did
+            res = cast(Sequencer, self.sequencer)(home, cands, limits)
             seqr = None
         else:
             self._batch = BatchEdgeChecker(cache.checker)

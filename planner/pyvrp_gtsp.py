@@ -69,8 +69,9 @@ def gtsp_data(G: NDArray[np.float64], groups: Sequence[NDArray[np.int64]]) -> Pr
         clients=[Client(location=i, required=False, group=int(owner[i])) for i in range(1, N)],
         depots=[Depot(location=0)],
         vehicle_types=[VehicleType(1)],
-        distance_matrices=[D],
-        duration_matrices=[np.zeros_like(D)],
+        # pyvrp's stub spells the matrices np.ndarray[int] (int as the shape parameter)
+        distance_matrices=[D],  # type: ignore[list-item]
+        duration_matrices=[np.zeros_like(D)],  # type: ignore[list-item]
         groups=[ClientGroup([int(v) - 1 for v in g], required=True) for g in groups],
     )
 

@@ -144,4 +144,4 @@ def detour_costs(
                 x = int(pred[x])
                 path.append(x)
             rm.detours[(a, b)] = path[::-1][1:]
-    return dict(zip(map(tuple, uv.tolist()), cost.tolist(), strict=True))
+    return {(a, b): c for (a, b), c in zip(uv.tolist(), cost.tolist(), strict=True)}

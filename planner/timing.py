@@ -37,11 +37,11 @@ class JointLimits:
     def from_arm(cls, arm: object) -> JointLimits:
         """Read the (already scaled) limits of a ``robots.Arm``."""
         return cls(
-            lower=np.asarray(arm.lower, dtype=float),  # type: ignore[attr-defined]
-            upper=np.asarray(arm.upper, dtype=float),  # type: ignore[attr-defined]
-            velocity=np.asarray(arm.velocity_limit, dtype=float),  # type: ignore[attr-defined]
-            acceleration=np.asarray(arm.acceleration_limit, dtype=float),  # type: ignore[attr-defined]
-            jerk=np.asarray(arm.jerk_limit, dtype=float),  # type: ignore[attr-defined]
+            lower=np.asarray(arm.lower, dtype=np.float64),  # type: ignore[attr-defined]
+            upper=np.asarray(arm.upper, dtype=np.float64),  # type: ignore[attr-defined]
+            velocity=np.asarray(arm.velocity_limit, dtype=np.float64),  # type: ignore[attr-defined]
+            acceleration=np.asarray(arm.acceleration_limit, dtype=np.float64),  # type: ignore[attr-defined]
+            jerk=np.asarray(arm.jerk_limit, dtype=np.float64),  # type: ignore[attr-defined]
         )
 
     @property

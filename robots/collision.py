@@ -31,6 +31,7 @@ overlapping cylinder pairs as free (seen on the forearm against the upper arm).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import coal
 import numpy as np
@@ -54,7 +55,7 @@ NAIVE_MAX_GEOMETRIES = 120
 
 
 #: the broad-phase managers :func:`broad_phase` picks from
-BroadPhase = (
+BroadPhase: TypeAlias = (
     pin.BroadPhaseManager_NaiveCollisionManager | pin.BroadPhaseManager_SSaPCollisionManager
 )
 

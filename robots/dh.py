@@ -17,6 +17,7 @@ built-in models' tables are :func:`robots.dh_models.dh_table`.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
@@ -55,11 +56,11 @@ class DHTable:
             np.asarray(self.theta_offset_rad, float),
         )
 
-    def with_lengths(self, a_m: ArrayLike, d_m: ArrayLike) -> DHTable:
+    def with_lengths(self, a_m: Iterable[float], d_m: Iterable[float]) -> DHTable:
         """A copy with other link lengths (m)."""
         return replace(self, a_m=tuple(map(float, a_m)), d_m=tuple(map(float, d_m)))
 
-    def with_offsets(self, theta_offset_rad: ArrayLike) -> DHTable:
+    def with_offsets(self, theta_offset_rad: Iterable[float]) -> DHTable:
         """A copy with other joint offsets (rad)."""
         return replace(self, theta_offset_rad=tuple(map(float, theta_offset_rad)))
 

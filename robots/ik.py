@@ -96,7 +96,7 @@ def _geometry_of(params: OpwParameters) -> _Geometry:
         psi=math.atan2(params.a2, params.c3),
         sign=np.array(params.sign, float),
         offset=np.array(params.offset_rad, float),
-        T_tool0_e=None if identity else np.linalg.inv(T_E_tool0),
+        T_tool0_e=None if identity else np.asarray(np.linalg.inv(T_E_tool0), dtype=np.float64),
         canonical_table=_canonical_table(params),
     )
 

@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from robots.errors import NotOpwError
 
@@ -207,12 +207,12 @@ def _arm_x(w2: Array, p: list[Array]) -> Array:
     return np.cross(w2, np.array([0.0, 0.0, 1.0]))
 
 
-def canonical_q(params: OpwParameters, q: Array) -> Array:
+def canonical_q(params: OpwParameters, q: ArrayLike) -> Array:
     """Canonical OPW joint values (rad) from URDF joint values ``q`` (..., 6)."""
     return np.asarray(q, float) * np.array(params.sign) + np.array(params.offset_rad)
 
 
-def fk_opw(params: OpwParameters, q: Array) -> Array:
+def fk_opw(params: OpwParameters, q: ArrayLike) -> Array:
     """``T_base_tool0`` (..., 4, 4) from URDF joint values ``q`` (..., 6) rad."""
     qc = canonical_q(params, q)
     q1, q2, q4, q5, q6 = qc[..., 0], qc[..., 1], qc[..., 3], qc[..., 4], qc[..., 5]

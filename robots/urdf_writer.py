@@ -10,6 +10,7 @@ Run ``python -m robots.urdf_writer`` to rewrite the shipped files.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,8 +45,8 @@ def link_shapes(spec: ArmSpec) -> list[LinkShape]:
     ]
 
 
-def _fmt(values: object) -> str:
-    return " ".join(f"{float(v):.6g}" for v in values)  # type: ignore[union-attr]
+def _fmt(values: Iterable[float]) -> str:
+    return " ".join(f"{float(v):.6g}" for v in values)
 
 
 def _geometry_xml(shape: LinkShape) -> str:

@@ -189,7 +189,7 @@ def _camera_view(
     tilt = float(np.arccos(np.clip(cos, -1.0, 1.0)))
     if tilt > np.radians(o.max_tilt_deg):
         return "board seen too obliquely or from behind", T_cam_target, np.zeros((0, 2)), tilt
-    uv = np.asarray(project(P), dtype=float).reshape(-1, 2)  # type: ignore[operator]
+    uv = np.asarray(project(P), dtype=np.float64).reshape(-1, 2)  # type: ignore[operator]
     w, h = image_size
     m = o.margin_frac * w
     inside = (uv[:, 0] >= m) & (uv[:, 0] <= w - 1 - m) & (uv[:, 1] >= m) & (uv[:, 1] <= h - 1 - m)

@@ -244,11 +244,11 @@ def _choose(blocks: Array, W: Array, n: int, ridge: Array, fixed: Sequence[int] 
         current = _phi(M, W)
         for slot in range(len(fixed), len(chosen)):
             M_out = M - blocks[chosen[slot]]
-            best = min(free, key=lambda i: _phi(M_out + blocks[i], W), default=None)
-            if best is not None and _phi(M_out + blocks[best], W) < current * (1 - 1e-9):
+            swap = min(free, key=lambda i: _phi(M_out + blocks[i], W), default=None)
+            if swap is not None and _phi(M_out + blocks[swap], W) < current * (1 - 1e-9):
                 free.append(chosen[slot])
-                free.remove(best)
-                chosen[slot] = best
+                free.remove(swap)
+                chosen[slot] = swap
                 improved = True
                 break
     return chosen

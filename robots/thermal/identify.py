@@ -170,7 +170,9 @@ class _Problem:
         return np.column_stack(cols) if cols else np.zeros((3 * len(self.q), 0))
 
 
-def serial_correlation(residual: Array, groups: Array, time_s: Array) -> tuple[float, int]:
+def serial_correlation(
+    residual: Array, groups: NDArray[np.int64], time_s: Array
+) -> tuple[float, int]:
     """Pooled lag-1 correlation of the fit residuals (N, 3) within each pose group in time
     order, and the number of consecutive pairs it rests on (per axis)."""
     num = den = 0.0
@@ -346,7 +348,7 @@ def identify(
         robot_model=robot_model,
         T_cell_base=np.asarray(geometry.T_cell_base, float),
         T_tool0_tcp=np.asarray(geometry.T_tool0_tcp, float),
-        covariance=cov * np.outer(scale, scale),
+        covariance=np.asarray(cov * np.outer(scale, scale), dtype=np.float64),
         fit={
             "residual_rms_m": rms,
             "residual_rms_before_m": float(np.sqrt(np.mean(r0**2))),

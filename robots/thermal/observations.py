@@ -81,7 +81,7 @@ class Observations:
     def __len__(self) -> int:
         return len(self.time_s)
 
-    def groups(self) -> Array:
+    def groups(self) -> NDArray[np.int64]:
         """Group index (N,) int: rows with the same target id and the same joint vector.
 
         Joint vectors are compared after rounding to ``SAME_POSE_TOL_RAD``.

@@ -87,8 +87,7 @@ def view_plan(
     lo, hi = np.asarray(lower, float), np.asarray(upper, float)
     poses: list[tuple[str, Array]] = []
     skipped: list[tuple[str, int, str]] = []
-    views = zip(options.tilts_rad, options.azimuths_rad, options.rolls_rad, strict=True)
-    views = list(views)
+    views = list(zip(options.tilts_rad, options.azimuths_rad, options.rolls_rad, strict=True))
     for tid, (pos, normal) in targets.items():
         p = T_base_cell[:3, :3] @ np.asarray(pos, float) + T_base_cell[:3, 3]
         n = T_base_cell[:3, :3] @ np.asarray(normal, float)
