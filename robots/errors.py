@@ -91,3 +91,7 @@ class MeshFileError(RobotModelError):
         self.path = path
         self.reason = reason
         super().__init__(f"{path}: {reason}")
+
+
+class DesignError(RobotModelError):
+    """A design cannot be chosen from its candidates (too few, or none determines the model)."""

@@ -15,7 +15,6 @@ from planner.calibration.select import (
     GeometryScore,
     PreselectOptions,
     choose_by_information,
-    design_value,
     geometry_score,
     preselect,
 )
@@ -29,6 +28,7 @@ from planner.calibration.tour import (
     view_metadata,
 )
 from planner.errors import NoCalibrationViewError
+from robots.design import design_value
 
 __all__ = [
     "Board",

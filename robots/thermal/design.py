@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from robots.design import choose_by_information
 from robots.dh import DHTable, fk_dh_arrays
 from robots.ik import solve_ik
 from robots.thermal.errors import ThermalDataError, ThermalSpecError
@@ -42,6 +43,9 @@ from robots.thermal.plan import view_pose
 from robots.transforms import invert
 
 Array = NDArray[np.float64]
+
+#: exchange passes of the design (each tries every slot; it stops when none improves)
+EXCHANGE_PASSES = 50
 
 
 @dataclass(frozen=True)
@@ -221,39 +225,6 @@ def candidate_views(
     return out, skipped
 
 
-def _phi(M: Array, W: Array) -> float:
-    try:
-        return float(np.trace(W @ np.linalg.inv(M)))
-    except np.linalg.LinAlgError:
-        return float("inf")
-
-
-def _choose(blocks: Array, W: Array, n: int, ridge: Array, fixed: Sequence[int] = ()) -> list[int]:
-    """Greedy then exchange: indices of ``n`` blocks (each ``G^T G``) minimising phi."""
-    chosen = list(fixed)
-    free = [i for i in range(len(blocks)) if i not in chosen]
-    while len(chosen) < n and free:
-        M = ridge + blocks[chosen].sum(axis=0)
-        best = min(free, key=lambda i: _phi(M + blocks[i], W))
-        chosen.append(best)
-        free.remove(best)
-    improved = True
-    while improved:
-        improved = False
-        M = ridge + blocks[chosen].sum(axis=0)
-        current = _phi(M, W)
-        for slot in range(len(fixed), len(chosen)):
-            M_out = M - blocks[chosen[slot]]
-            swap = min(free, key=lambda i: _phi(M_out + blocks[i], W), default=None)
-            if swap is not None and _phi(M_out + blocks[swap], W) < current * (1 - 1e-9):
-                free.append(chosen[slot])
-                free.remove(swap)
-                chosen[slot] = swap
-                improved = True
-                break
-    return chosen
-
-
 def evaluate(
     table: DHTable,
     T_cell_base: ArrayLike,
@@ -309,7 +280,7 @@ def design_views(
     W = np.einsum("ski,skj->ij", D_s, D_s)
     n_terms = blocks.shape[1]
     ridge = np.eye(n_terms) * o.ridge * np.trace(blocks.mean(axis=0)) / n_terms
-    chosen = _choose(blocks, W, n, ridge, fixed)
+    chosen = choose_by_information(blocks, n, ridge, W, EXCHANGE_PASSES, fixed=list(fixed))
     views = [candidates[i] for i in chosen]
     sigma, cov = evaluate(table, T_cell_base, T_tool0_tcp, Q[chosen], stops, o)
     terms = tuple(LENGTH_TERMS[i] for i in length_links(table))

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from robots.design import choose_by_information, design_value
 from robots.dh import fk_dh
 from robots.models import MODELS
 from robots.thermal import (
@@ -20,8 +21,6 @@ from robots.thermal import (
 )
 from robots.thermal.design import (
     DesignOptions,
-    _choose,
-    _phi,
     candidate_views,
     design_views,
     evaluate,
@@ -89,12 +88,12 @@ def test_exchange_leaves_no_improving_swap(table, T_tool0_tcp, stops, candidates
     blocks = np.einsum("vki,vkj->vij", D_v, D_v)
     W = np.einsum("ski,skj->ij", D_s, D_s)
     ridge = np.eye(blocks.shape[1]) * 1e-9
-    chosen = _choose(blocks, W, 6, ridge)
-    phi = _phi(ridge + blocks[chosen].sum(axis=0), W)
+    chosen = choose_by_information(blocks, 6, ridge, W, exchange_passes=50)
+    phi = design_value(blocks, chosen, ridge, W)
     for slot in range(6):
         for j in set(range(len(blocks))) - set(chosen):
             swapped = [*chosen[:slot], j, *chosen[slot + 1 :]]
-            assert _phi(ridge + blocks[swapped].sum(axis=0), W) >= phi * (1 - 1e-6)
+            assert design_value(blocks, swapped, ridge, W) >= phi * (1 - 1e-6)
 
 
 def test_collision_veto_is_respected(table, T_cell_base, T_tool0_tcp):

@@ -53,8 +53,8 @@ from cell.errors import CellError
 from measure import StereoCalibration
 from measure.target import TargetSpec
 from planner.calibration import Candidates, choose_by_information, design_value
-from planner.calibration.select import information_factors
 from robots.calibration import dh_error_twists, fk_with_errors, structural_redundancies
+from robots.design import information_factors
 from robots.dh import DHTable
 from robots.transforms import invert, skew
 
