@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from cell.config.markers import marker_in_cell
 from cell.config.target import read_corners
 from robots import LimitsError, RobotModelError
 from robots.errors import MeshFileError
@@ -22,10 +23,40 @@ Problem = tuple[str, object, str]
 def cell_problems(cfg: CellConfig) -> list[Problem]:
     """Every problem of ``cfg``; the robot is built only once the cheaper checks pass."""
     return (
-        duplicate_ids(cfg) + part_temperature_problems(cfg) + path_problems(cfg)
+        duplicate_ids(cfg)
+        + marker_problems(cfg)
+        + part_temperature_problems(cfg)
+        + path_problems(cfg)
         or mesh_problems(cfg)
         or robot_problems(cfg)
     )
+
+
+#: a scale bar's length may differ from its markers' nominal distance by at most this (m)
+SCALE_BAR_NOMINAL_TOL_M = 0.005
+
+
+def marker_problems(cfg: CellConfig) -> list[Problem]:
+    """Scale bars that name unknown markers, join a marker to itself, or whose length does not
+    match their markers' nominal distance (a wrong id or a length in mm)."""
+    problems: list[Problem] = []
+    markers = {m.id: m for m in cfg.reference_markers}
+    T_cell_part = cfg.T_cell_part()
+    for i, bar in enumerate(cfg.scale_bars):
+        ends = []
+        for key, mid in (("from", bar.from_), ("to", bar.to)):
+            if mid not in markers:
+                problems.append((f"scale_bars[{i}].{key}", mid, "names no reference marker"))
+            else:
+                ends.append(marker_in_cell(markers[mid], T_cell_part)[0])
+        if bar.from_ == bar.to:
+            problems.append((f"scale_bars[{i}].to", bar.to, "a scale bar joins two markers"))
+        elif len(ends) == 2:
+            nominal = float(np.linalg.norm(ends[1] - ends[0]))
+            if abs(nominal - bar.length_m) > SCALE_BAR_NOMINAL_TOL_M:
+                problems.append((f"scale_bars[{i}].length_m", bar.length_m,
+                                 f"its markers are {nominal:.4f} m apart nominally"))  # fmt: skip
+    return problems
 
 
 def duplicate_ids(cfg: CellConfig) -> list[Problem]:
@@ -33,6 +64,7 @@ def duplicate_ids(cfg: CellConfig) -> list[Problem]:
     for group, items in (
         ("part.holes", cfg.part.holes),
         ("reference_targets", cfg.reference_targets),
+        ("reference_markers", cfg.reference_markers),
     ):
         seen: set[str] = set()
         for i, item in enumerate(items):

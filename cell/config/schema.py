@@ -17,6 +17,7 @@ import numpy as np
 from pydantic import Field, PrivateAttr, field_validator
 
 from cell.config.datums import Alignment, Datum, Tolerances
+from cell.config.markers import ReferenceMarker, ScaleBar
 from cell.config.pose import IDENTITY, Pose, Positive, Vec3, _Strict, unit_normal
 from cell.config.shapes import ShapeSpec
 from cell.config.target import CalibrationTargetBoard
@@ -145,6 +146,8 @@ class CellConfig(_Strict):
     environment: Environment = Environment()
     reference_targets: list[ReferenceTarget] = []
     calibration_target: CalibrationTarget | None = None
+    reference_markers: list[ReferenceMarker] = []
+    scale_bars: list[ScaleBar] = []
 
     _source_path: Path | None = PrivateAttr(default=None)
     _raw_text: str = PrivateAttr(default="")

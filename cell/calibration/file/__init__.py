@@ -7,6 +7,7 @@ from cell.calibration.file.modelfile import (
     calibration_to_dict,
     check_age,
     check_belongs,
+    fingerprint,
     load_calibration,
     save_calibration,
 )
@@ -17,6 +18,7 @@ __all__ = [
     "cell_provenance",
     "check_age",
     "check_belongs",
+    "fingerprint",
     "load_calibration",
     "save_calibration",
 ]

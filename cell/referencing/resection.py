@@ -1,0 +1,163 @@
+"""Locating one stop against the surveyed markers: the head's pose ``T_cell_left`` from the
+markers both of its cameras see (stereo resection), robust, with its covariance.
+
+Unknowns: ``T_cell_left = (R0 exp(w), t0 + tau)`` about the arm's prior ``(R0, t0)``. The
+markers' ideal-pixel residuals in both cameras are minimised (Levenberg-Marquardt, SciPy; six
+unknowns). A marker whose residual exceeds :data:`OUTLIER_SIGMA` (it moved since the survey, or
+it is misidentified) is refused by id and the pose solved again while at least
+:data:`MIN_MARKERS` remain; with fewer the stop is not referenced (``ok`` False: the run falls
+back to the arm). The covariance holds the image noise and the survey's marker covariance
+(``A C_markers A^T`` with ``A = (J^T J)^-1 J^T J_markers``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from cell.referencing.observations import MarkerView, T_left_right, ideal_pixels
+from measure import StereoCalibration
+from robots.transforms import invert, skew, so3_exp
+
+Array = NDArray[np.float64]
+
+#: a stop is referenced with at least this many markers
+MIN_MARKERS = 4
+#: a marker this many sigma off the others is refused
+OUTLIER_SIGMA = 5.0
+
+
+@dataclass(frozen=True)
+class Resection:
+    """The located stop: ``T_cell_left`` (4, 4) and the covariance (6, 6) of ``(w, tau)`` (rad,
+    m; ``w`` turns the left camera's own axes, ``tau`` moves its origin); ``used`` and
+    ``refused`` (id -> reason) markers; ``rms_px`` the residual RMS; ``ok`` False when fewer
+    than :data:`MIN_MARKERS` markers remain (``reason`` says why)."""
+
+    ok: bool
+    T_cell_left: Array
+    covariance: Array
+    used: tuple[str, ...]
+    refused: dict[str, str] = field(default_factory=dict)
+    rms_px: float = float("nan")
+    reason: str = ""
+
+    def point(self, p_left: Array, cov_left: Array | None = None) -> tuple[Array, Array]:
+        """A point measured in the left camera frame, in the cell frame, and its covariance
+        (3, 3) m²: the resection's and (when given) the point's own."""
+        R, t = self.T_cell_left[:3, :3], self.T_cell_left[:3, 3]
+        p_left = np.asarray(p_left, float)
+        J = np.hstack([-R @ skew(p_left), np.eye(3)])  # d p_cell / d (w, tau)
+        cov = J @ self.covariance @ J.T
+        if cov_left is not None:
+            cov = cov + R @ np.asarray(cov_left, float) @ R.T
+        return R @ p_left + t, cov
+
+
+def _pose(T0: Array, x: Array) -> Array:
+    T = T0.copy()
+    T[:3, :3] = T0[:3, :3] @ so3_exp(x[:3])
+    T[:3, 3] = T0[:3, 3] + x[3:]
+    return T
+
+
+def _project(T_cell_cam: Array, K: Array, P: Array) -> Array:
+    T_cam_cell = invert(T_cell_cam)
+    p = P @ T_cam_cell[:3, :3].T + T_cam_cell[:3, 3]
+    return (p[:, :2] / p[:, 2:3]) @ K[:2, :2].T + K[:2, 2]
+
+
+class _Obs:
+    """Ideal-pixel observations of one view: rows (marker index, camera, uv)."""
+
+    def __init__(self, view: MarkerView, stereo: StereoCalibration, index: dict[str, int]):
+        rows, uvs = [], []
+        for side, seen in enumerate((view.uv_left, view.uv_right)):
+            ids = [m for m in sorted(seen) if m in index]
+            if ids:
+                name = ("left", "right")[side]
+                uvs.append(ideal_pixels(stereo, name, np.array([seen[m] for m in ids])))
+                rows += [(index[m], side) for m in ids]
+        self.marker = np.array([r[0] for r in rows], dtype=np.int64)
+        self.side = np.array([r[1] for r in rows], dtype=np.int64)
+        self.uv = np.vstack(uvs) if uvs else np.zeros((0, 2))
+
+    def keep(self, mask: NDArray[np.bool_]) -> None:
+        self.marker, self.side, self.uv = self.marker[mask], self.side[mask], self.uv[mask]
+
+
+def _residuals(
+    x: Array, T0: Array, obs: _Obs, P: Array, K: tuple[Array, Array], T_lr: Array, sigma: float
+) -> Array:
+    T = _pose(T0, x)
+    out = np.empty_like(obs.uv)
+    for s, T_cam in enumerate((T, T @ T_lr)):
+        m = obs.side == s
+        if m.any():
+            out[m] = _project(T_cam, K[s], P[obs.marker[m]]) - obs.uv[m]
+    return (out / sigma).ravel()
+
+
+def resect(
+    view: MarkerView,
+    stereo: StereoCalibration,
+    marker_ids: tuple[str, ...],
+    positions: Array,
+    covariance: Array | None,
+    sigma_px: float,
+) -> Resection:
+    """Locate ``view`` against the surveyed markers ``marker_ids`` (positions (n, 3) m, cell
+    frame; their covariance (3n, 3n) m² or None) (module doc)."""
+    index = {m: k for k, m in enumerate(marker_ids)}
+    obs = _Obs(view, stereo, index)
+    K = (np.asarray(stereo.K_left, float), np.asarray(stereo.K_right, float))
+    T_lr, T0 = T_left_right(stereo), np.asarray(view.T_cell_left_prior, float)
+    refused: dict[str, str] = {}
+    while True:
+        used = sorted({marker_ids[j] for j in obs.marker})
+        if len(used) < MIN_MARKERS:
+            why = f"{len(used)} usable markers, {MIN_MARKERS} needed"
+            return Resection(False, T0, np.full((6, 6), np.nan), tuple(used), refused, reason=why)
+        args = (T0, obs, positions, K, T_lr, sigma_px)
+        sol = least_squares(_residuals, np.zeros(6), args=args, method="lm", xtol=1e-14, ftol=1e-14)
+        r = sol.fun.reshape(-1, 2)
+        per = np.linalg.norm(r, axis=1) / np.sqrt(2.0)
+        worst = int(np.argmax(per))
+        if per[worst] <= OUTLIER_SIGMA:
+            break
+        bad = marker_ids[obs.marker[worst]]
+        refused[bad] = f"{per[worst]:.1f} sigma off the other markers (moved since the survey?)"
+        obs.keep(obs.marker != index[bad])
+    T = _pose(T0, sol.x)
+    J = sol.jac
+    JtJ_inv = np.linalg.inv(J.T @ J)
+    cov = JtJ_inv.copy()
+    if covariance is not None:
+        Jm = _marker_jacobian(sol.x, args)
+        cols = np.unique(obs.marker)
+        idx = (3 * cols[:, None] + np.arange(3)).ravel()
+        A = JtJ_inv @ J.T @ Jm[:, idx]
+        cov = cov + A @ covariance[np.ix_(idx, idx)] @ A.T
+    rms = float(np.sqrt(np.mean((r * sigma_px) ** 2)))
+    return Resection(True, T, cov, tuple(used), refused, rms)
+
+
+def _marker_jacobian(x: Array, args: tuple) -> Array:
+    """d residuals / d marker positions (k, 3n), by central differences (exact enough: the
+    projection is smooth at the 1e-7 m step)."""
+    T0, obs, P, K, T_lr, sigma = args
+    h = 1e-7
+    J = np.zeros((2 * len(obs.uv), P.size))
+    for j in np.unique(obs.marker):
+        for a in range(3):
+            Pp, Pm = P.copy(), P.copy()
+            Pp[j, a] += h
+            Pm[j, a] -= h
+            J[:, 3 * j + a] = (
+                _residuals(x, T0, obs, Pp, K, T_lr, sigma)
+                - _residuals(x, T0, obs, Pm, K, T_lr, sigma)
+            ) / (2 * h)
+    return J

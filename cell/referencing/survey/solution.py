@@ -1,0 +1,31 @@
+"""What a survey solver returns, before the gauge."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class RawSolution:
+    """Marker centres (n, 3) m and view poses (V, 4, 4) in the solver's datum (view 0 held);
+    ``covariance``: the markers' joint covariance (3n, 3n) m² (None: not computed); ``chi2`` the
+    weighted squared residual sum with ``dof`` degrees of freedom; ``iterations`` taken;
+    ``head``: the self-calibrated ``(K_left, K_right, T_left_right)`` (None: held as given)."""
+
+    points: Array
+    poses: Array
+    covariance: Array | None
+    chi2: float
+    dof: int
+    iterations: int
+    head: tuple[Array, Array, Array] | None = None
+
+    @property
+    def variance_factor(self) -> float:
+        """chi2 / dof: 1 when the stated pixel σ is right."""
+        return self.chi2 / self.dof

@@ -1,0 +1,132 @@
+"""The survey adjustment with GTSAM, self-calibrating the head.
+
+Variables: every view's left-camera pose ``X_v`` and right-camera pose ``Y_v``, every marker
+``L_j``, each camera's pinhole calibration (``Cal3_S2``: fx, fy, skew, cx, cy) and the rig
+``R = T_left_right``. Factors:
+
+- ``GeneralSFMFactor2Cal3_S2``: a marker's ideal pixel (undistorted with ``stereo.json``'s lens
+  model) in the left camera (``X_v``, ``L_j``, left calibration) or the right (``Y_v``, ...);
+- a rig factor per view (:func:`_rig_error`): ``Y_v = X_v R``, held tight (one rigid head);
+- priors: both calibrations and the rig at ``stereo.json``'s values with its stated sigma, the
+  skew at zero; the scale bars as range factors; view 0 loosely (the free datum, moved by
+  :mod:`.gauge`).
+
+A head whose calibration is off by its stated sigma bends a network adjusted with the head
+held fixed by 100-300 um (its rig rotation, principal points and focal lengths); the views at
+several distances and orientations determine them, and the scale then comes from the bars.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import gtsam
+import numpy as np
+from gtsam.symbol_shorthand import C, L, R, X, Y
+
+from cell.referencing.survey.problem import Array, SurveyProblem
+from cell.referencing.survey.solution import RawSolution
+
+#: the datum prior on view 0 (m and rad). It acts only on the network's six free rigid motions,
+#: which absorb it exactly (no residual changes), and the gauge moves the result afterwards.
+DATUM_SIGMA = 1e-3
+#: how tightly each view's right camera follows the rig (rad, m)
+RIG_TIE_SIGMA = 1e-8
+#: the skew's prior (px): none in a real sensor
+SKEW_SIGMA = 1e-6
+#: the numerical step of the rig factor's Jacobians (rad, m)
+_H = 1e-7
+
+
+def _calibration(K: Array) -> gtsam.Cal3_S2:
+    return gtsam.Cal3_S2(K[0, 0], K[1, 1], K[0, 1], K[0, 2], K[1, 2])
+
+
+def _K(cal: gtsam.Cal3_S2) -> Array:
+    return np.asarray(cal.K(), float)
+
+
+def _rig_error(this: gtsam.CustomFactor, values: gtsam.Values, H) -> np.ndarray:
+    """``Logmap((X R)^-1 Y)`` (6,) of the factor's keys (X_v, Y_v, R); numerical Jacobians."""
+    keys = [this.keys()[i] for i in range(3)]
+    poses = [values.atPose3(k) for k in keys]
+
+    def err(p: list[gtsam.Pose3]) -> np.ndarray:
+        return gtsam.Pose3.Logmap(p[0].compose(p[2]).between(p[1]))
+
+    e = err(poses)
+    if H is not None:
+        for i in range(3):
+            J = np.zeros((6, 6))
+            for k in range(6):
+                d = np.zeros(6)
+                d[k] = _H
+                plus, minus = list(poses), list(poses)
+                plus[i], minus[i] = poses[i].retract(d), poses[i].retract(-d)
+                J[:, k] = (err(plus) - err(minus)) / (2 * _H)
+            H[i] = J
+    return e
+
+
+def _priors(graph: gtsam.NonlinearFactorGraph, problem: SurveyProblem) -> None:
+    for c in range(2):
+        s = problem.K_sigma[c]
+        sig = np.array([s[0], s[1], SKEW_SIGMA, s[2], s[3]])
+        noise = gtsam.noiseModel.Diagonal.Sigmas(np.maximum(sig, 1e-9))
+        graph.add(gtsam.PriorFactorCal3_S2(C(c), _calibration(problem.K[c]), noise))
+    rig = gtsam.noiseModel.Diagonal.Sigmas(np.maximum(problem.rig_sigma, 1e-9))
+    graph.add(gtsam.PriorFactorPose3(R(0), gtsam.Pose3(problem.T_left_right), rig))
+    datum = gtsam.noiseModel.Isotropic.Sigma(6, DATUM_SIGMA)
+    graph.add(gtsam.PriorFactorPose3(X(0), gtsam.Pose3(problem.poses0[0]), datum))
+    for b in problem.bars:
+        noise = gtsam.noiseModel.Isotropic.Sigma(1, max(b.sigma_m, 1e-9))
+        graph.add(gtsam.RangeFactor3(L(b.i), L(b.j), b.length_m, noise))
+
+
+def _graph(problem: SurveyProblem) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Values]:
+    graph = gtsam.NonlinearFactorGraph()
+    values = gtsam.Values()
+    pix = gtsam.noiseModel.Isotropic.Sigma(2, problem.sigma_px)
+    for k in range(len(problem.uv)):
+        v, j, s = int(problem.view[k]), int(problem.marker[k]), int(problem.side[k])
+        pose = X(v) if s == 0 else Y(v)
+        uv = problem.uv[k].reshape(2, 1)
+        graph.add(gtsam.GeneralSFMFactor2Cal3_S2(uv, pix, pose, L(j), C(s)))
+    tie = gtsam.noiseModel.Isotropic.Sigma(6, RIG_TIE_SIGMA)
+    for v in range(problem.n_views):
+        graph.add(gtsam.CustomFactor(tie, [X(v), Y(v), R(0)], partial(_rig_error)))
+        values.insert(X(v), gtsam.Pose3(problem.poses0[v]))
+        values.insert(Y(v), gtsam.Pose3(problem.poses0[v] @ problem.T_left_right))
+    for j in range(problem.n_markers):
+        values.insertPoint3(L(j), problem.points0[j])
+    for c in range(2):
+        values.insert(C(c), _calibration(problem.K[c]))
+    values.insert(R(0), gtsam.Pose3(problem.T_left_right))
+    _priors(graph, problem)
+    return graph, values
+
+
+def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
+    """Adjust ``problem`` (module doc); ``covariance``: also the markers' joint covariance
+    (3n, 3n) m², scaled by the variance factor when that exceeds 1."""
+    graph, values = _graph(problem)
+    params = gtsam.LevenbergMarquardtParams()
+    params.setRelativeErrorTol(1e-10)
+    params.setAbsoluteErrorTol(1e-10)
+    params.setMaxIterations(100)
+    opt = gtsam.LevenbergMarquardtOptimizer(graph, values, params)
+    result = opt.optimize()
+    points = np.array([result.atPoint3(L(j)) for j in range(problem.n_markers)])
+    poses = np.array([result.atPose3(X(v)).matrix() for v in range(problem.n_views)])
+    head = (_K(result.atCal3_S2(C(0))), _K(result.atCal3_S2(C(1))), result.atPose3(R(0)).matrix())
+    chi2 = 2.0 * graph.error(result)
+    n_obs = 2 * len(problem.uv) + len(problem.bars)
+    dof = max(n_obs - 6 * problem.n_views - 3 * problem.n_markers - 16, 1)
+    cov = None
+    if covariance:
+        marginals = gtsam.Marginals(graph, result)
+        keys = gtsam.KeyVector()
+        for j in range(problem.n_markers):
+            keys.append(L(j))
+        cov = marginals.jointMarginalCovariance(keys).fullMatrix() * max(1.0, chi2 / dof)
+    return RawSolution(points, poses, cov, chi2, dof, int(opt.iterations()), head)

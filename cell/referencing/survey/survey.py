@@ -1,0 +1,171 @@
+"""The survey: views of the reference markers -> refusals -> one bundle adjustment (GTSAM) ->
+outliers named and dropped -> the gauge -> :class:`SurveyResult`.
+
+Outliers: an observation whose residual exceeds :data:`OUTLIER_SIGMA` times the pixel σ is
+named and dropped, with a warning, and the adjustment is run again; when the rest no longer
+passes the refusals the survey is refused naming it. Scale: from the scale bars when the cell
+has any, else from the head's baseline alone (about 100 ppm, said in a warning).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from cell.config import CellConfig
+from cell.config.markers import marker_in_cell
+from cell.referencing.errors import SurveyRefusedError
+from cell.referencing.observations import MarkerView
+from cell.referencing.survey.gauge import to_gauge
+from cell.referencing.survey.problem import Array, SurveyProblem, build_problem, predict
+from cell.referencing.survey.refusals import check_network, usable_views
+from cell.referencing.survey.result import SurveyResult
+from cell.referencing.survey.solution import RawSolution
+from cell.referencing.survey.solve_gtsam import solve_gtsam
+from measure import StereoCalibration
+
+#: an observation this many σ off is an outlier
+OUTLIER_SIGMA = 5.0
+#: the scale uncertainty of a network scaled by the head's baseline alone (ppm): the baseline's
+#: calibration is good to about 0.01 mm in 100 mm
+BASELINE_SCALE_PPM = 100.0
+
+
+@dataclass(frozen=True)
+class SurveyOptions:
+    """``sigma_px``: the marker centres' standard deviation (px), from the marker benchmark
+    (docs/referencing.md); ``max_outlier_rounds``: re-adjustments after dropping outliers."""
+
+    sigma_px: float = 0.05
+    max_outlier_rounds: int = 3
+
+
+def survey(
+    cell: CellConfig,
+    stereo: StereoCalibration,
+    views: list[MarkerView],
+    options: SurveyOptions | None = None,
+) -> SurveyResult:
+    """Adjust ``views`` of ``cell``'s reference markers (module doc). Raises
+    :class:`SurveyRefusedError` naming the marker, view or pieces."""
+    o = options or SurveyOptions()
+    t0 = time.perf_counter()
+    if not cell.reference_markers:
+        raise SurveyRefusedError(f"cell {cell.name!r}", "has no reference_markers")
+    T_cell_part = cell.T_cell_part()
+    ids = [m.id for m in cell.reference_markers]
+    nominal = np.array([marker_in_cell(m, T_cell_part)[0] for m in cell.reference_markers])
+    fixture = np.array([m.on == "fixture" for m in cell.reference_markers])
+    kept, dropped = usable_views(views, ids, nominal)
+    check_network(kept, ids, nominal)
+    bars = [(b.from_, b.to, b.length_m, b.U_m) for b in cell.scale_bars]
+    problem = build_problem(kept, stereo, ids, nominal, bars, o.sigma_px)
+    warnings: list[str] = []
+    outliers: list[tuple[str, str, str, float]] = []
+    for _ in range(o.max_outlier_rounds + 1):
+        raw = solve_gtsam(problem, covariance=False)
+        z = _normalised(problem, raw)
+        bad = z > OUTLIER_SIGMA
+        if not bad.any():
+            break
+        for k in np.flatnonzero(bad):
+            item = (
+                problem.view_ids[problem.view[k]],
+                ids[problem.marker[k]],
+                ("left", "right")[problem.side[k]],
+                float(z[k]),
+            )
+            outliers.append(item)
+            warnings.append(
+                f"view {item[0]}: marker {item[1]} ({item[2]} image) is {item[3]:.1f} "
+                f"sigma off: dropped"
+            )
+        problem = problem.without(~bad)
+        _check_still(problem, kept, ids, nominal)
+    t1 = time.perf_counter()
+    raw = solve_gtsam(problem, covariance=True)
+    t2 = time.perf_counter()
+    g = to_gauge(raw.points, raw.covariance, nominal, fixture)
+    assert g.covariance is not None
+    scale_ppm, source = _scale(problem, g.points, g.covariance)
+    if not problem.bars:
+        warnings.append(
+            f"no scale bars: the scale comes from the head's baseline alone, about "
+            f"{BASELINE_SCALE_PPM:.0f} ppm"
+        )
+    res = (predict(problem, raw.poses, raw.points, raw.head) - problem.uv).ravel()
+    return SurveyResult(
+        marker_ids=tuple(ids),
+        positions_cell=g.points,
+        covariance=g.covariance,
+        gauge=g.kind,
+        gauge_residuals_m=g.residuals_m,
+        rms_px=float(np.sqrt(np.mean(res**2))),
+        variance_factor=raw.variance_factor,
+        n_views=problem.n_views,
+        n_observations=len(problem.uv),
+        scale_sigma_ppm=scale_ppm,
+        scale_source=source,
+        dropped_views=tuple(dropped),
+        outliers=tuple(outliers),
+        warnings=tuple(warnings),
+        timings={"adjust_s": t1 - t0, "covariance_s": t2 - t1},
+    )
+
+
+def _normalised(problem: SurveyProblem, raw: RawSolution) -> Array:
+    r = (predict(problem, raw.poses, raw.points, raw.head) - problem.uv) / problem.sigma_px
+    return np.linalg.norm(r, axis=1) / np.sqrt(2.0)
+
+
+def _check_still(
+    problem: SurveyProblem, views: list[MarkerView], ids: list[str], nominal: Array
+) -> None:
+    """The refusals again on what is left after dropping outliers."""
+    left = {
+        (problem.view_ids[v], ids[j], s)
+        for v, j, s in zip(problem.view, problem.marker, problem.side, strict=True)
+    }
+    rebuilt = []
+    for view in views:
+        uvl = {m: uv for m, uv in view.uv_left.items() if (view.view_id, m, 0) in left}
+        uvr = {m: uv for m, uv in view.uv_right.items() if (view.view_id, m, 1) in left}
+        rebuilt.append(MarkerView(view.view_id, uvl, uvr, view.T_cell_left_prior))
+    check_network(rebuilt, ids, nominal)
+
+
+def _scale(problem: SurveyProblem, points: Array, cov: Array) -> tuple[float, str]:
+    """The scale's standard uncertainty (ppm) along the network's longest distance, and its
+    source."""
+    d = points[:, None, :] - points[None, :, :]
+    i, j = np.unravel_index(np.argmax(np.einsum("ijk,ijk->ij", d, d)), d.shape[:2])
+    u = (points[j] - points[i]) / np.linalg.norm(points[j] - points[i])
+    a = np.zeros(len(cov))
+    a[3 * i : 3 * i + 3], a[3 * j : 3 * j + 3] = -u, u
+    ppm = 1e6 * float(np.sqrt(a @ cov @ a)) / float(np.linalg.norm(points[j] - points[i]))
+    if problem.bars:
+        return ppm, f"{len(problem.bars)} scale bars and the head's baseline"
+    return max(ppm, BASELINE_SCALE_PPM), "the head's baseline alone"
+
+
+def refined_head(
+    stereo: StereoCalibration, head: tuple[Array, Array, Array] | None
+) -> StereoCalibration:
+    """``stereo`` with the survey's self-calibrated camera matrices and rig (its lens
+    distortion and image size kept)."""
+    if head is None:
+        return stereo
+    K_l, K_r, T_lr = head
+    T_rl = np.linalg.inv(T_lr)
+    return StereoCalibration(
+        stereo.image_size,
+        K_l,
+        np.asarray(stereo.dist_left, float),
+        K_r,
+        np.asarray(stereo.dist_right, float),
+        T_rl[:3, :3],
+        T_rl[:3, 3],
+        source=f"{stereo.source} (refined by the survey)",
+    )
