@@ -112,6 +112,7 @@ def survey(
         outliers=tuple(outliers),
         warnings=tuple(warnings),
         timings={"adjust_s": t1 - t0, "covariance_s": t2 - t1},
+        stereo=refined_head(stereo, raw.head),
     )
 
 
