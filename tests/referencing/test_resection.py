@@ -1,0 +1,64 @@
+"""Locating a stop against the surveyed markers: the pose, a moved marker refused by id, the
+fall-back with too few markers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cell.referencing import resect
+from cell.referencing.layout import stop_pose
+from cell.referencing.synthetic import observe
+from robots.transforms import so3_exp
+
+
+@pytest.fixture(scope="module")
+def network(marker_truth):
+    """The markers as a perfect survey would give them (the truth), with a 5 um covariance."""
+    n = len(marker_truth.ids)
+    return marker_truth.ids, marker_truth.true, np.eye(3 * n) * (5e-6) ** 2
+
+
+def _stop(small_cell, stereo, marker_truth, hole="PVL", seed=0):
+    T = stop_pose(small_cell, stereo, hole)
+    prior = T.copy()
+    prior[:3, :3] = so3_exp(np.radians([0.02, -0.01, 0.03])) @ T[:3, :3]
+    prior[:3, 3] += [3e-4, -2e-4, 1e-4]  # the arm's idea of the pose
+    return T, observe(marker_truth, stereo, T, hole, 0.05, np.random.default_rng(seed), prior)
+
+
+def test_a_stop_is_located_to_micrometres(small_cell, stereo, marker_truth, network):
+    T, view = _stop(small_cell, stereo, marker_truth)
+    r = resect(view, stereo, *network, 0.05)
+    assert r.ok and len(r.used) >= 4 and not r.refused
+    c_left = np.array([0.0, 0.0, 0.25])
+    p, cov = r.point(c_left)
+    true = T[:3, :3] @ c_left + T[:3, 3]
+    assert np.linalg.norm(p - true) < 15e-6
+    assert np.linalg.norm(p - true) < 4 * np.sqrt(np.trace(cov))
+
+
+def test_a_marker_moved_after_the_survey_is_caught_by_id(small_cell, stereo, marker_truth,
+                                                        network):  # fmt: skip
+    ids, P, C = network
+    T, view = _stop(small_cell, stereo, marker_truth)
+    moved = view.both()[0]
+    P_survey = P.copy()
+    P_survey[ids.index(moved)] += [0.0, 4e-4, 0.0]  # knocked 0.4 mm since the survey
+    r = resect(view, stereo, ids, P_survey, C, 0.05)
+    assert r.ok and moved in r.refused and moved not in r.used
+    assert "moved since the survey" in r.refused[moved]
+    p, _ = r.point(np.array([0.0, 0.0, 0.25]))
+    assert np.linalg.norm(p - (T[:3, :3] @ [0.0, 0.0, 0.25] + T[:3, 3])) < 20e-6
+
+
+def test_a_stop_with_three_markers_falls_back(small_cell, stereo, marker_truth, network):
+    _T, view = _stop(small_cell, stereo, marker_truth)
+    keep = view.both()[:3]
+    for d in (view.uv_left, view.uv_right):
+        for m in list(d):
+            if m not in keep:
+                d.pop(m)
+    r = resect(view, stereo, *network, 0.05)
+    assert not r.ok and "3 usable markers, 4 needed" in r.reason
+    assert np.array_equal(r.T_cell_left, view.T_cell_left_prior)

@@ -1,0 +1,137 @@
+"""The survey on simulated observations: accuracy against the truth, the refusals, outliers,
+the scale without bars, GTSAM against the SciPy reference, markers.json."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import small_cell_text, survey_observations
+
+from cell.config import builtin_cell_path, parse_cell
+from cell.referencing import MarkersFileError, SurveyRefusedError, load_markers, survey
+from cell.referencing.markersfile import check_markers, save_markers
+from cell.referencing.survey.gauge import rigid_fit, to_gauge
+from cell.referencing.survey.problem import build_problem
+from cell.referencing.survey.refusals import usable_views
+from cell.referencing.survey.solve_gtsam import solve_gtsam
+from cell.referencing.survey.solve_scipy import solve_scipy
+from cell.referencing.synthetic import draw_marker_truth
+
+
+@pytest.fixture(scope="module")
+def surveyed(small_cell, stereo, marker_truth):
+    views = survey_observations(small_cell, stereo, marker_truth)
+    return views, survey(small_cell, stereo, views)
+
+
+def _rigid_error(P: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    T = rigid_fit(P, Q)
+    return np.linalg.norm(P @ T[:3, :3].T + T[:3, 3] - Q, axis=1)
+
+
+def test_the_network_agrees_with_the_truth_within_its_stated_sigma(surveyed, marker_truth):
+    _views, res = surveyed
+    rows = [marker_truth.ids.index(m) for m in res.marker_ids]
+    e = _rigid_error(res.positions_cell, marker_truth.true[rows])
+    assert np.sqrt(np.mean(e**2)) < 10e-6 and e.max() < 25e-6
+    assert res.gauge == "fixture markers" and 0.8 < res.variance_factor < 1.25
+    assert np.median(res.sigma_m()) < 10e-6 and res.scale_sigma_ppm < 10
+    assert not res.outliers and res.stereo is not None
+
+
+def test_gtsam_agrees_with_the_scipy_reference(small_cell, stereo, surveyed, marker_truth):
+    views, _ = surveyed
+    ids = list(marker_truth.ids)
+    bars = [(b.from_, b.to, b.length_m, b.U_m) for b in small_cell.scale_bars]
+    kept, _ = usable_views(views, ids, marker_truth.nominal)
+    problem = build_problem(kept, stereo, ids, marker_truth.nominal, bars, 0.05)
+    g, s = solve_gtsam(problem, covariance=False), solve_scipy(problem)
+    gauged = [
+        to_gauge(x.points, None, marker_truth.nominal, marker_truth.on_fixture).points
+        for x in (g, s)
+    ]  # the solvers' own datum is arbitrary: compare in the gauge
+    assert np.abs(gauged[0] - gauged[1]).max() < 2e-6
+
+
+def test_a_marker_seen_too_rarely_is_refused_by_name(small_cell, stereo, marker_truth):
+    views = survey_observations(small_cell, stereo, marker_truth)
+    gone = "P003"
+    for v in views[: len(views) - 2]:
+        v.uv_left.pop(gone, None)
+        v.uv_right.pop(gone, None)
+    left = sum(gone in v.either() for v in views)
+    if left >= 3:
+        for v in views:
+            v.uv_left.pop(gone, None)
+            v.uv_right.pop(gone, None)
+    with pytest.raises(SurveyRefusedError, match=f"marker {gone}: seen in [0-2] views"):
+        survey(small_cell, stereo, views)
+
+
+def test_a_network_in_two_pieces_is_refused(small_cell, stereo, marker_truth):
+    views = survey_observations(small_cell, stereo, marker_truth)
+    fixture = {m.id for m in small_cell.reference_markers if m.on == "fixture"}
+    split = []
+    for v in views:  # no view sees the table and the part together
+        part = set(v.either()) - fixture
+        drop = fixture if len(part) >= 2 else part
+        split.append(type(v)(v.view_id, {m: p for m, p in v.uv_left.items() if m not in drop},
+                             {m: p for m, p in v.uv_right.items() if m not in drop},
+                             v.T_cell_left_prior))  # fmt: skip
+    with pytest.raises(SurveyRefusedError, match="network: in 2 pieces"):
+        survey(small_cell, stereo, split)
+
+
+def test_rays_meeting_at_a_narrow_angle_are_refused(small_cell, stereo, marker_truth):
+    views = survey_observations(small_cell, stereo, marker_truth)
+    target = "P001"
+    first = next(v for v in views if target in v.either())
+    axis = first.T_cell_left_prior[:3, 3] - marker_truth.nominal[marker_truth.ids.index(target)]
+    narrow = []
+    for v in views:
+        ray = v.T_cell_left_prior[:3, 3] - marker_truth.nominal[marker_truth.ids.index(target)]
+        cos = ray @ axis / np.linalg.norm(ray) / np.linalg.norm(axis)
+        if cos < np.cos(np.radians(8)):  # only views within 8 deg of the first see it
+            v.uv_left.pop(target, None)
+            v.uv_right.pop(target, None)
+        narrow.append(v)
+    with pytest.raises(SurveyRefusedError, match=f"marker {target}: (its rays meet|seen in)"):
+        survey(small_cell, stereo, narrow)
+
+
+def test_an_outlier_is_named_dropped_and_the_rest_holds(small_cell, stereo, marker_truth):
+    views = survey_observations(small_cell, stereo, marker_truth)
+    v = next(v for v in views if "P002" in v.uv_left)
+    v.uv_left["P002"] = v.uv_left["P002"] + np.array([3.0, -2.0])  # a misdetection
+    res = survey(small_cell, stereo, views)
+    assert [(o[0], o[1], o[2]) for o in res.outliers] == [(v.view_id, "P002", "left")]
+    assert any("P002" in w and "dropped" in w for w in res.warnings)
+
+
+def test_without_scale_bars_the_survey_says_its_scale_uncertainty(stereo, marker_truth):
+    cell = parse_cell(small_cell_text(bars=False), "nobars.yaml", builtin_cell_path())
+    truth = draw_marker_truth(cell, seed=3)
+    res = survey(cell, stereo, survey_observations(cell, stereo, truth))
+    assert res.scale_sigma_ppm >= 100 and "baseline alone" in res.scale_source
+    assert any("no scale bars" in w and "100 ppm" in w for w in res.warnings)
+
+
+def test_markers_file_round_trip_and_refusals(surveyed, small_cell, stereo, tmp_path: Path):
+    _views, res = surveyed
+    path = save_markers(tmp_path / "markers.json", res, small_cell, stereo)
+    doc, ids, P, C = load_markers(path)
+    assert ids == res.marker_ids and np.allclose(P, res.positions_cell)
+    assert np.allclose(C, res.covariance)
+    check_markers(doc, str(path), small_cell, stereo)
+    other = parse_cell(small_cell_text().replace("id: P001", "id: Q001"), "o.yaml",
+                       builtin_cell_path())  # fmt: skip
+    with pytest.raises(MarkersFileError, match="cell_fingerprint"):
+        check_markers(doc, str(path), other, stereo)
+    with pytest.raises(MarkersFileError, match=r"created_utc: the survey is .* days old"):
+        check_markers(doc | {"created_utc": "2026-01-01T00:00:00Z"}, str(path), small_cell, stereo)
+    path.write_text(json.dumps(doc | {"version": 9}))
+    with pytest.raises(MarkersFileError, match="version"):
+        load_markers(path)
