@@ -62,3 +62,23 @@ def test_a_stop_with_three_markers_falls_back(small_cell, stereo, marker_truth, 
     r = resect(view, stereo, *network, 0.05)
     assert not r.ok and "3 usable markers, 4 needed" in r.reason
     assert np.array_equal(r.T_cell_left, view.T_cell_left_prior)
+
+
+def test_the_marker_jacobian_matches_finite_differences(small_cell, stereo, marker_truth):
+    from cell.referencing import resection as rs
+
+    T, view = _stop(small_cell, stereo, marker_truth)
+    obs = rs._Obs(view, stereo, {m: k for k, m in enumerate(marker_truth.ids)})
+    K = (np.asarray(stereo.K_left), np.asarray(stereo.K_right))
+    args = (view.T_cell_left_prior, obs, marker_truth.true, K, rs.T_left_right(stereo), 0.05)
+    x = np.array([1e-4, -2e-4, 3e-4, 1e-4, 0.0, -1e-4])
+    J = rs._marker_jacobian(x, args)
+    h = 1e-7
+    for j in np.unique(obs.marker)[:3]:
+        for a in range(3):
+            Pp, Pm = marker_truth.true.copy(), marker_truth.true.copy()
+            Pp[j, a] += h
+            Pm[j, a] -= h
+            num = (rs._residuals(x, *args[:2], Pp, *args[3:])
+                   - rs._residuals(x, *args[:2], Pm, *args[3:])) / (2 * h)  # fmt: skip
+            np.testing.assert_allclose(J[:, 3 * j + a], num, atol=1e-6 * np.abs(num).max())
