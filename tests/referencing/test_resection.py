@@ -67,7 +67,7 @@ def test_a_stop_with_three_markers_falls_back(small_cell, stereo, marker_truth, 
 def test_the_marker_jacobian_matches_finite_differences(small_cell, stereo, marker_truth):
     from cell.referencing import resection as rs
 
-    T, view = _stop(small_cell, stereo, marker_truth)
+    _T, view = _stop(small_cell, stereo, marker_truth)
     obs = rs._Obs(view, stereo, {m: k for k, m in enumerate(marker_truth.ids)})
     K = (np.asarray(stereo.K_left), np.asarray(stereo.K_right))
     args = (view.T_cell_left_prior, obs, marker_truth.true, K, rs.T_left_right(stereo), 0.05)
