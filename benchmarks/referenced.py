@@ -104,7 +104,7 @@ def run_seed(seed: int, args, cell, stereo) -> dict:
     true_g = true_pts @ T[:3, :3].T + T[:3, 3]
     e = res.positions_cell - true_g
     z = np.abs(e) / res.sigma_m()
-    out["within_2s"] = float(np.mean(np.all(z < 2.0, axis=1)))
+    out["within_2s"] = float(np.mean(z < 2.0))  # per coordinate: 95.4 % for an honest sigma
     F = rigid_fit(res.positions_cell, true_pts)
     ef = np.linalg.norm(res.positions_cell @ F[:3, :3].T + F[:3, 3] - true_pts, axis=1)
     out["survey_rms_um"], out["survey_max_um"] = 1e6 * np.sqrt(np.mean(ef**2)), 1e6 * ef.max()

@@ -55,6 +55,8 @@ class SurveyProblem:
     #: (fx, fy, cx, cy) px, and the rig's rotation (3, rad) and translation (3, m)
     K_sigma: tuple[Array, Array] = (np.full(4, 0.3), np.full(4, 0.3))
     rig_sigma: Array = field(default_factory=lambda: np.array([1e-5, 5e-5, 2e-5, 5e-6, 2e-6, 1e-5]))
+    #: per camera, the stated sigma of the lens terms the survey refines (k1, k2, p1, p2)
+    dist_sigma: tuple[Array, Array] = (np.array([2e-4, 2e-3, 2e-5, 2e-5]),) * 2
 
     @property
     def n_views(self) -> int:
@@ -108,6 +110,10 @@ def build_problem(
     return SurveyProblem(
         K_sigma=(np.asarray(unc.K_std_left_px, float), np.asarray(unc.K_std_right_px, float)),
         rig_sigma=np.concatenate([unc.rvec_std_rad, unc.T_std_m]).astype(float),
+        dist_sigma=(
+            np.asarray(unc.dist_std_left, float)[:4],
+            np.asarray(unc.dist_std_right, float)[:4],
+        ),
         marker_ids=tuple(marker_ids),
         view_ids=tuple(v.view_id for v in views),
         view=np.array(rows_v, dtype=np.int64),
@@ -123,21 +129,39 @@ def build_problem(
     )
 
 
-def predict(
-    problem: SurveyProblem,
-    poses: Array,
-    points: Array,
-    head: tuple[Array, Array, Array] | None = None,
-) -> Array:
+#: a self-calibrated head: (K_left, K_right, T_left_right, residual lens terms left, right),
+#: the lens terms ``(k1, k2, p1, p2)`` applied to the ideal pixels' normalised coordinates
+Head = tuple[Array, Array, Array, Array, Array]
+
+
+def residual_distortion(x: Array, d: Array) -> Array:
+    """Normalised coordinates (k, 2) moved by the lens terms ``d = (k1, k2, p1, p2)`` (OpenCV's
+    and GTSAM's Cal3DS2 model)."""
+    k1, k2, p1, p2 = d
+    u, v = x[:, 0], x[:, 1]
+    r2 = u * u + v * v
+    g = 1.0 + k1 * r2 + k2 * r2 * r2
+    return np.stack(
+        [
+            u * g + 2 * p1 * u * v + p2 * (r2 + 2 * u * u),
+            v * g + p1 * (r2 + 2 * v * v) + 2 * p2 * u * v,
+        ],
+        axis=1,
+    )
+
+
+def predict(problem: SurveyProblem, poses: Array, points: Array, head: Head | None = None) -> Array:
     """Ideal pixels (k, 2) of every observation for view poses (V, 4, 4) and points (n, 3);
-    ``head``: the self-calibrated ``(K_left, K_right, T_left_right)`` (None: the problem's)."""
-    K_l, K_r, T_lr = head if head is not None else (*problem.K, problem.T_left_right)
-    T = poses[problem.view]
+    ``head``: the self-calibrated head (:data:`Head`; None: the problem's, no lens terms)."""
+    if head is None:
+        head = (problem.K[0], problem.K[1], problem.T_left_right, np.zeros(4), np.zeros(4))
+    K_l, K_r, T_lr, d_l, d_r = head
+    T = poses[problem.view].copy()
     right = problem.side == 1
-    T = T.copy()
     T[right] = T[right] @ T_lr
     R, t = T[:, :3, :3], T[:, :3, 3]
     p_cam = np.einsum("kji,kj->ki", R, points[problem.marker] - t)  # R^T (p - t)
-    K = np.where(right[:, None, None], K_r, K_l)
     x = p_cam[:, :2] / p_cam[:, 2:3]
+    x = np.where(right[:, None], residual_distortion(x, d_r), residual_distortion(x, d_l))
+    K = np.where(right[:, None, None], K_r, K_l)
     return np.einsum("kij,kj->ki", K[:, :2, :2], x) + K[:, :2, 2]

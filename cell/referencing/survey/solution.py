@@ -15,7 +15,8 @@ class RawSolution:
     """Marker centres (n, 3) m and view poses (V, 4, 4) in the solver's datum (view 0 held);
     ``covariance``: the markers' joint covariance (3n, 3n) m² (None: not computed); ``chi2`` the
     weighted squared residual sum with ``dof`` degrees of freedom; ``iterations`` taken;
-    ``head``: the self-calibrated ``(K_left, K_right, T_left_right)`` (None: held as given)."""
+    ``head``: the self-calibrated ``(K_left, K_right, T_left_right, lens terms left, right)``
+    (:data:`cell.referencing.survey.problem.Head`; None: held as given)."""
 
     points: Array
     poses: Array
@@ -23,7 +24,7 @@ class RawSolution:
     chi2: float
     dof: int
     iterations: int
-    head: tuple[Array, Array, Array] | None = None
+    head: tuple[Array, Array, Array, Array, Array] | None = None
 
     @property
     def variance_factor(self) -> float:

@@ -1,11 +1,13 @@
 """The survey adjustment with GTSAM, self-calibrating the head.
 
 Variables: every view's left-camera pose ``X_v`` and right-camera pose ``Y_v``, every marker
-``L_j``, each camera's pinhole calibration (``Cal3_S2``: fx, fy, skew, cx, cy) and the rig
+``L_j``, each camera's calibration (``Cal3DS2``: fx, fy, skew, cx, cy, k1, k2, p1, p2) and the rig
 ``R = T_left_right``. Factors:
 
-- ``GeneralSFMFactor2Cal3_S2``: a marker's ideal pixel (undistorted with ``stereo.json``'s lens
-  model) in the left camera (``X_v``, ``L_j``, left calibration) or the right (``Y_v``, ...);
+- ``GeneralSFMFactor2Cal3DS2``: a marker's ideal pixel (undistorted with ``stereo.json``'s lens
+  model) in the left camera (``X_v``, ``L_j``, left calibration) or the right (``Y_v``, ...); the
+  calibration's lens terms (k1, k2, p1, p2) start at zero and take up what ``stereo.json``'s
+  lens model leaves;
 - a rig factor per view (:func:`_rig_error`): ``Y_v = X_v R``, held tight (one rigid head);
 - priors: both calibrations and the rig at ``stereo.json``'s values with its stated sigma, the
   skew at zero; the scale bars as range factors; view 0 loosely (the free datum, moved by
@@ -38,12 +40,16 @@ SKEW_SIGMA = 1e-6
 _H = 1e-7
 
 
-def _calibration(K: Array) -> gtsam.Cal3_S2:
-    return gtsam.Cal3_S2(K[0, 0], K[1, 1], K[0, 1], K[0, 2], K[1, 2])
+def _calibration(K: Array) -> gtsam.Cal3DS2:
+    return gtsam.Cal3DS2(K[0, 0], K[1, 1], K[0, 1], K[0, 2], K[1, 2], 0.0, 0.0, 0.0, 0.0)
 
 
-def _K(cal: gtsam.Cal3_S2) -> Array:
+def _K(cal: gtsam.Cal3DS2) -> Array:
     return np.asarray(cal.K(), float)
+
+
+def _lens(cal: gtsam.Cal3DS2) -> Array:
+    return np.array([cal.k1(), cal.k2(), cal.p1(), cal.p2()])
 
 
 def _rig_error(this: gtsam.CustomFactor, values: gtsam.Values, H) -> np.ndarray:
@@ -70,10 +76,10 @@ def _rig_error(this: gtsam.CustomFactor, values: gtsam.Values, H) -> np.ndarray:
 
 def _priors(graph: gtsam.NonlinearFactorGraph, problem: SurveyProblem) -> None:
     for c in range(2):
-        s = problem.K_sigma[c]
-        sig = np.array([s[0], s[1], SKEW_SIGMA, s[2], s[3]])
+        s, d = problem.K_sigma[c], problem.dist_sigma[c]
+        sig = np.array([s[0], s[1], SKEW_SIGMA, s[2], s[3], *d])
         noise = gtsam.noiseModel.Diagonal.Sigmas(np.maximum(sig, 1e-9))
-        graph.add(gtsam.PriorFactorCal3_S2(C(c), _calibration(problem.K[c]), noise))
+        graph.add(gtsam.PriorFactorCal3DS2(C(c), _calibration(problem.K[c]), noise))
     rig = gtsam.noiseModel.Diagonal.Sigmas(np.maximum(problem.rig_sigma, 1e-9))
     graph.add(gtsam.PriorFactorPose3(R(0), gtsam.Pose3(problem.T_left_right), rig))
     datum = gtsam.noiseModel.Isotropic.Sigma(6, DATUM_SIGMA)
@@ -91,7 +97,7 @@ def _graph(problem: SurveyProblem) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Va
         v, j, s = int(problem.view[k]), int(problem.marker[k]), int(problem.side[k])
         pose = X(v) if s == 0 else Y(v)
         uv = problem.uv[k].reshape(2, 1)
-        graph.add(gtsam.GeneralSFMFactor2Cal3_S2(uv, pix, pose, L(j), C(s)))
+        graph.add(gtsam.GeneralSFMFactor2Cal3DS2(uv, pix, pose, L(j), C(s)))
     tie = gtsam.noiseModel.Isotropic.Sigma(6, RIG_TIE_SIGMA)
     for v in range(problem.n_views):
         graph.add(gtsam.CustomFactor(tie, [X(v), Y(v), R(0)], partial(_rig_error)))
@@ -118,10 +124,11 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     result = opt.optimize()
     points = np.array([result.atPoint3(L(j)) for j in range(problem.n_markers)])
     poses = np.array([result.atPose3(X(v)).matrix() for v in range(problem.n_views)])
-    head = (_K(result.atCal3_S2(C(0))), _K(result.atCal3_S2(C(1))), result.atPose3(R(0)).matrix())
+    cams = [result.atCal3DS2(C(c)) for c in range(2)]
+    head = (_K(cams[0]), _K(cams[1]), result.atPose3(R(0)).matrix(), _lens(cams[0]), _lens(cams[1]))
     chi2 = 2.0 * graph.error(result)
     n_obs = 2 * len(problem.uv) + len(problem.bars)
-    dof = max(n_obs - 6 * problem.n_views - 3 * problem.n_markers - 16, 1)
+    dof = max(n_obs - 6 * problem.n_views - 3 * problem.n_markers - 24, 1)
     cov = None
     if covariance:
         marginals = gtsam.Marginals(graph, result)

@@ -9,13 +9,14 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
-from cell.referencing.survey.problem import Array, SurveyProblem, predict
+from cell.referencing.survey.problem import Array, Head, SurveyProblem, predict
 from cell.referencing.survey.solution import RawSolution
 from cell.referencing.survey.solve_gtsam import DATUM_SIGMA
 from robots.transforms import so3_exp
 
-#: head unknowns: (fx, fy, cx, cy) per camera, then the rig's rotation and translation
-N_HEAD = 14
+#: head unknowns: (fx, fy, cx, cy) per camera, the rig's rotation and translation, then the
+#: lens terms (k1, k2, p1, p2) per camera
+N_HEAD = 22
 
 
 def _poses(problem: SurveyProblem, x: Array) -> Array:
@@ -27,7 +28,7 @@ def _poses(problem: SurveyProblem, x: Array) -> Array:
     return T
 
 
-def _head(problem: SurveyProblem, h: Array) -> tuple[Array, Array, Array]:
+def _head(problem: SurveyProblem, h: Array) -> Head:
     Ks = []
     for c in range(2):
         K = problem.K[c].copy()
@@ -39,7 +40,7 @@ def _head(problem: SurveyProblem, h: Array) -> tuple[Array, Array, Array]:
     T = problem.T_left_right.copy()
     T[:3, :3] = T[:3, :3] @ so3_exp(h[8:11])
     T[:3, 3] += h[11:14]
-    return Ks[0], Ks[1], T
+    return Ks[0], Ks[1], T, h[14:18], h[18:22]
 
 
 def _split(problem: SurveyProblem, x: Array) -> tuple[Array, Array, Array]:
@@ -58,7 +59,15 @@ def _residuals(x: Array, problem: SurveyProblem) -> Array:
         d = np.linalg.norm(points[b.i] - points[b.j]) - b.length_m
         r.append(np.array([d / max(b.sigma_m, 1e-9)]))
     r.append(x[:6] / DATUM_SIGMA)
-    sig = np.concatenate([problem.K_sigma[0], problem.K_sigma[1], problem.rig_sigma])
+    sig = np.concatenate(
+        [
+            problem.K_sigma[0],
+            problem.K_sigma[1],
+            problem.rig_sigma,
+            problem.dist_sigma[0],
+            problem.dist_sigma[1],
+        ]
+    )
     r.append(h / np.maximum(sig, 1e-9))
     return np.concatenate(r)
 
@@ -74,6 +83,7 @@ def _sparsity(problem: SurveyProblem):
             A[r, 6 * v : 6 * v + 6] = 1
             A[r, 6 * V + 3 * j : 6 * V + 3 * j + 3] = 1
             A[r, head0 + 4 * s : head0 + 4 * s + 4] = 1
+            A[r, head0 + 14 + 4 * s : head0 + 18 + 4 * s] = 1
             if s == 1:
                 A[r, head0 + 8 : head0 + 14] = 1
     for q, b in enumerate(problem.bars):
@@ -105,6 +115,6 @@ def solve_scipy(problem: SurveyProblem) -> RawSolution:
         max_nfev=200,
     )
     chi2 = float(res.fun @ res.fun)
-    dof = max(2 * len(problem.uv) + len(problem.bars) - 6 * V - 3 * problem.n_markers - 16, 1)
+    dof = max(2 * len(problem.uv) + len(problem.bars) - 6 * V - 3 * problem.n_markers - 24, 1)
     poses, points, h = _split(problem, res.x)
     return RawSolution(points, poses, None, chi2, dof, int(res.nfev), _head(problem, h))

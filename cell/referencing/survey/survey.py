@@ -19,7 +19,7 @@ from cell.config.markers import marker_in_cell
 from cell.referencing.errors import SurveyRefusedError
 from cell.referencing.observations import MarkerView
 from cell.referencing.survey.gauge import to_gauge
-from cell.referencing.survey.problem import Array, SurveyProblem, build_problem, predict
+from cell.referencing.survey.problem import Array, Head, SurveyProblem, build_problem, predict
 from cell.referencing.survey.refusals import check_network, usable_views
 from cell.referencing.survey.result import SurveyResult
 from cell.referencing.survey.solution import RawSolution
@@ -151,21 +151,25 @@ def _scale(problem: SurveyProblem, points: Array, cov: Array) -> tuple[float, st
     return max(ppm, BASELINE_SCALE_PPM), "the head's baseline alone"
 
 
-def refined_head(
-    stereo: StereoCalibration, head: tuple[Array, Array, Array] | None
-) -> StereoCalibration:
-    """``stereo`` with the survey's self-calibrated camera matrices and rig (its lens
-    distortion and image size kept)."""
+def refined_head(stereo: StereoCalibration, head: Head | None) -> StereoCalibration:
+    """``stereo`` with the survey's self-calibrated camera matrices, rig and lens terms (its
+    k3 and image size kept; the residual lens terms are added to ``stereo.json``'s, a first-order
+    approximation as they are small)."""
     if head is None:
         return stereo
-    K_l, K_r, T_lr = head
+    K_l, K_r, T_lr, d_l, d_r = head
     T_rl = np.linalg.inv(T_lr)
+    dist = []
+    for base, d in ((stereo.dist_left, d_l), (stereo.dist_right, d_r)):
+        out = np.asarray(base, float).copy()
+        out[:4] += d
+        dist.append(out)
     return StereoCalibration(
         stereo.image_size,
         K_l,
-        np.asarray(stereo.dist_left, float),
+        dist[0],
         K_r,
-        np.asarray(stereo.dist_right, float),
+        dist[1],
         T_rl[:3, :3],
         T_rl[:3, 3],
         source=f"{stereo.source} (refined by the survey)",
