@@ -79,8 +79,9 @@ def test_moves_backwards_along_the_path_and_stop_holds(controller: str) -> None:
     ):
         c.load_trajectory(q, stops, 0.004)
         c.move_to_stop(2)
-        while c.status().row == 0:
-            pass
+        st = c.status()
+        while st.row == 0:  # until the arm is seen on its way
+            st = c.status()
         c.stop()
         st = c.status()
         # where the arm holds, by its joints: the RAPID module reports row 0 ("not on a row")
