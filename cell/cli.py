@@ -86,11 +86,21 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+#: the exit codes every command uses (docs/conventions.md)
+EXIT_CODES = """exit codes:
+  0    success (holes out of tolerance still exit 0: the run worked)
+  1    written, with something left out (a hole unreachable, holes left out of a tour)
+  2    a user mistake or a refusal: one line on stderr naming the file, field and value
+  130  interrupted (Ctrl-C); what was stored is kept"""
+
+
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The argument parser with the subcommand ``argv`` names (every subcommand without one)."""
     parser = OneLineParser(
         prog="holecell",
         description="Robot-vision hole inspection cells: plan tours, run them, measure holes.",
+        epilog=EXIT_CODES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

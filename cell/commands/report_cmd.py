@@ -11,7 +11,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add ``report``."""
     p = sub.add_parser(
         "report",
-        help="write report.json / report.csv of a run and print its summary",
+        help="write a run's report.json, report.csv, report.html and report.qif; print its summary",
         description=(
             "Reads RUN_DIR/results.sqlite (never modifies it) and writes RUN_DIR/report.json "
             "(summary, every hole, every event; SI units) and RUN_DIR/report.csv (one row per "

@@ -139,3 +139,16 @@ def test_thermal_simulate_and_measure_name_the_bad_number(tmp_path: Path, capsys
     with pytest.raises(SystemExit):
         main(["measure", "a.png", "b.png", "--stereo", "s.json", "--diameter", "12"])
     assert "--diameter: 12 m: metres expected, this looks like millimetres" in _one_line(capsys)
+
+
+def test_help_names_every_report_file_the_exit_codes_and_the_readme_the_current_forms(capsys):
+    from cell import cli
+
+    with pytest.raises(SystemExit):
+        cli.main(["--help"])
+    out = capsys.readouterr().out
+    assert "report.html and report.qif" in out
+    assert "1    written, with something left out" in out and "2    a user mistake" in out
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    commands = readme[readme.index("## The command line") : readme.index("## The cell file")]
+    assert "holecell calibrate --left" not in commands
