@@ -11,7 +11,7 @@ to the fixture markers' nominal positions afterwards. The scale comes from the h
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -68,8 +68,6 @@ class SurveyProblem:
 
     def without(self, keep: NDArray[np.bool_]) -> SurveyProblem:
         """The same problem with only the observations ``keep``."""
-        from dataclasses import replace
-
         return replace(
             self,
             view=self.view[keep],
