@@ -75,5 +75,7 @@ def run_spc(args: argparse.Namespace) -> int:
         print(
             f"  {s.name:<22} n {cap.n:3d}  Cpk {cpk:>6}  out of control {len(cap.out_of_control)}"
         )
+        if cap.cpk is not None and not cap.enough_for_capability:
+            print(f"    warning: {cap.capability_note()}")
     print(f"wrote {csv_path} and {html_path}")
     return 0

@@ -3,6 +3,7 @@ one summary line for the characteristics without statistics."""
 
 from __future__ import annotations
 
+import csv
 from pathlib import Path
 
 import numpy as np
@@ -52,3 +53,16 @@ def test_a_missing_path_or_a_file_is_named_as_such(tmp_path: Path, capsys) -> No
     assert "a file, not a run directory (give the folder holding report.qif)" in (
         capsys.readouterr().err
     )
+
+
+def test_a_cpk_from_two_runs_comes_with_its_interval_and_a_warning(tmp_path: Path, capsys):
+    root = _runs(tmp_path / "runs", 2)
+    assert main(["spc", str(root), "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "warning: 2 runs, fewer than the 25 a capability study needs" in out
+    assert "AIAG SPC manual 2nd ed., ISO 22514-2" in out and "95 % interval" in out
+    rows = list(csv.DictReader((tmp_path / "spc.csv").open()))
+    with_cpk = [r for r in rows if r["cpk"]]
+    assert with_cpk and all(float(r["cpk_ci95_low"]) < float(r["cpk"]) < float(r["cpk_ci95_high"])
+                            and r["capability_note"] for r in with_cpk)  # fmt: skip
+    assert "&#8224;" in (tmp_path / "spc.html").read_text()

@@ -16,6 +16,7 @@ Out-of-control rules (Nelson 1984, the first three; and the MR chart's limit):
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -51,6 +52,43 @@ class Capability:
     ppk: float | None
     #: run index (0-based, in the given order) -> the rules it broke
     out_of_control: dict[int, list[str]] = field(default_factory=dict)
+    #: Cpk's approximate 95 % confidence interval (Bissell 1990); None without a Cpk
+    cpk_ci95: tuple[float, float] | None = None
+
+    @property
+    def enough_for_capability(self) -> bool:
+        """Whether ``n`` reaches :data:`MIN_CAPABILITY_N`: below it a capability index is
+        indicative only (its interval says how little it is known)."""
+        return self.n >= MIN_CAPABILITY_N
+
+    def capability_note(self) -> str:
+        """One line for a report, empty when there are enough values."""
+        if self.enough_for_capability:
+            return ""
+        ci = (
+            ""
+            if self.cpk_ci95 is None
+            else f" (Cpk 95 % interval {self.cpk_ci95[0]:.2f} to {self.cpk_ci95[1]:.2f})"
+        )
+        return (
+            f"{self.n} runs, fewer than the {MIN_CAPABILITY_N} a capability study needs "
+            f"({CAPABILITY_REFERENCE}): indicative only{ci}"
+        )
+
+
+#: the smallest number of individual values for a capability index (AIAG SPC manual, 2nd ed.,
+#: and ISO 22514-2: at least 25 subgroups; for individuals, 25 values)
+MIN_CAPABILITY_N = 25
+CAPABILITY_REFERENCE = "AIAG SPC manual 2nd ed., ISO 22514-2"
+#: the normal quantile of a two-sided 95 % interval
+Z95 = 1.959963984540054
+
+
+def cpk_interval(cpk: float, n: int) -> tuple[float, float]:
+    """Bissell's (1990) approximate 95 % confidence interval of Cpk from ``n`` values:
+    ``Cpk +- z sqrt(1/(9n) + Cpk^2/(2(n-1)))``."""
+    half = Z95 * math.sqrt(1.0 / (9.0 * n) + cpk * cpk / (2.0 * (n - 1)))
+    return cpk - half, cpk + half
 
 
 def _index(lsl: float | None, usl: float | None, mean: float, sigma: float):
@@ -132,4 +170,5 @@ def capability(
         pp=pp,
         ppk=ppk,
         out_of_control=out_of_control(x, mean, lcl, ucl, ucl_mr),
+        cpk_ci95=None if cpk is None else cpk_interval(cpk, len(x)),
     )

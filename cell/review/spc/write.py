@@ -1,7 +1,8 @@
 """``spc.csv`` and ``spc.html`` of an SPC study (:mod:`cell.review.spc.stats`).
 
 CSV: one row per characteristic, SI units (m): ``characteristic, kind, n, n_not_evaluated,
-mean_m, s_m, sigma_within_m, mr_bar_m, lcl_m, ucl_m, ucl_mr_m, lsl_m, usl_m, cp, cpk, pp, ppk,
+mean_m, s_m, sigma_within_m, mr_bar_m, lcl_m, ucl_m, ucl_mr_m, lsl_m, usl_m, cp, cpk, cpk_ci95_low,
+cpk_ci95_high, capability_note, pp, ppk,
 cpk_rice, out_of_control`` (``cpk_rice``: positions only, :mod:`cell.review.spc.bounded`;
 the runs out of control as ``run:rule+rule`` separated by ``;``; empty cells where a figure
 does not exist). HTML: the same table (``<table id="spc">``, one
@@ -20,10 +21,17 @@ from typing import Any
 from cell.review.spc.bounded import RiceFit, rice_cpk
 from cell.review.spc.chart import charts, unit
 from cell.review.spc.collect import Series
-from cell.review.spc.stats import RULES, Capability, capability
+from cell.review.spc.stats import (
+    CAPABILITY_REFERENCE,
+    MIN_CAPABILITY_N,
+    RULES,
+    Capability,
+    capability,
+)
 
 COLUMNS = ("characteristic", "kind", "n", "n_not_evaluated", "mean_m", "s_m", "sigma_within_m",
-           "mr_bar_m", "lcl_m", "ucl_m", "ucl_mr_m", "lsl_m", "usl_m", "cp", "cpk", "pp", "ppk",
+           "mr_bar_m", "lcl_m", "ucl_m", "ucl_mr_m", "lsl_m", "usl_m", "cp", "cpk", "cpk_ci95_low",
+           "cpk_ci95_high", "capability_note", "pp", "ppk",
            "cpk_rice", "out_of_control")  # fmt: skip
 CSS = """body{font-family:Helvetica,Arial,sans-serif;margin:24px;color:#222;font-size:13px}
 h1{font-size:20px}h2{font-size:15px;margin:22px 0 6px;border-bottom:1px solid #999}
@@ -88,6 +96,9 @@ def csv_rows(results: list[Analysis]) -> list[dict[str, Any]]:
                 ucl_mr_m=cap.ucl_mr,
                 cp=cap.cp,
                 cpk=cap.cpk,
+                cpk_ci95_low=None if cap.cpk_ci95 is None else cap.cpk_ci95[0],
+                cpk_ci95_high=None if cap.cpk_ci95 is None else cap.cpk_ci95[1],
+                capability_note=cap.capability_note(),
                 pp=cap.pp,
                 ppk=cap.ppk,
                 cpk_rice=None if a.rice is None else a.rice.cpk,
@@ -131,7 +142,7 @@ def _table(results: list[Analysis]) -> str:
                 _fmt(s.lsl, k, digits) or "-",
                 _fmt(s.usl, k, digits),
                 _fmt(cap.cp) or "-",
-                f"<span{cpk_cls}>{_fmt(cap.cpk) or '-'}</span>",
+                f"<span{cpk_cls}>{_fmt(cap.cpk) or '-'}</span>" + _cpk_ci(cap),
                 _fmt(cap.pp) or "-",
                 _fmt(cap.ppk) or "-",
                 _fmt(None if a.rice is None else a.rice.cpk) or "-",
@@ -162,7 +173,9 @@ def render_html(results: list[Analysis], runs: list[str]) -> str:
 estimate MR̄/1.128 (control limits, Cp, Cpk); s: overall standard deviation (Pp, Ppk). Position:
 one-sided, USL = the zone diameter without bonus, Cpk = (USL − mean)/3σ̂, no Cp; its values are
 bounded at 0 and skewed, so a Rice fit gives the ISO 22514-2 percentile index
-(USL − X50)/(X99.865 − X50) beside it. Cpk below 1.33 in red. Rules for "out of control":</p>
+(USL − X50)/(X99.865 − X50) beside it. Cpk below 1.33 in red. From fewer than
+{MIN_CAPABILITY_N} runs ({CAPABILITY_REFERENCE}) a Cpk is indicative only: its approximate 95 %
+interval (Bissell) follows it, marked &#8224;. Rules for "out of control":</p>
 <ul class="note">{rules}</ul>
 {_table(results)}{chart_html}<h2>Runs</h2><ol class="note">{run_list}</ol></body></html>"""
 
@@ -178,3 +191,12 @@ def write_spc(results: list[Analysis], runs: list[str], out_dir: str | Path) -> 
             w.writerow({k: ("" if row.get(k) is None else row.get(k, "")) for k in COLUMNS})
     (out / "spc.html").write_text(render_html(results, runs), encoding="utf-8")
     return out / "spc.csv", out / "spc.html"
+
+
+def _cpk_ci(cap: Capability) -> str:
+    """The Cpk's 95 % interval and a warning mark when the runs are too few for capability."""
+    if cap.cpk_ci95 is None or cap.enough_for_capability:
+        return ""
+    lo, hi = cap.cpk_ci95
+    title = escape(cap.capability_note())
+    return f' <span class="note" title="{title}">[{lo:.2f}, {hi:.2f}]&#8224;</span>'
