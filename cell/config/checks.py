@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from cell.config.markers import marker_in_cell
+from cell.config.plausible import length_problems
 from cell.config.target import read_corners
 from robots import LimitsError, RobotModelError
 from robots.errors import MeshFileError
@@ -24,6 +25,7 @@ def cell_problems(cfg: CellConfig) -> list[Problem]:
     """Every problem of ``cfg``; the robot is built only once the cheaper checks pass."""
     return (
         duplicate_ids(cfg)
+        + length_problems(cfg)
         + marker_problems(cfg)
         + part_temperature_problems(cfg)
         + path_problems(cfg)

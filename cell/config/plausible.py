@@ -49,3 +49,38 @@ def size_problems(where: str, hole: Any) -> list[Problem]:
             field = f"{where}.tolerances.size.{name}"
             out += _over(field, value, MAX_SIZE_DEVIATION_M, "a size deviation")
     return out
+
+
+#: the largest coordinate (m) of anything in a robot cell, or of a hole in its part: a cell is a
+#: few metres across, so a figure beyond was typed in millimetres
+MAX_CELL_COORDINATE_M = 20.0
+#: the largest offset (m) of the head from the flange, and of its stand-off
+MAX_TOOL_OFFSET_M = 2.0
+
+
+def length_problems(cfg: Any) -> list[Problem]:
+    """Positions and offsets of the cell file (``cfg``: a :class:`CellConfig`) too large to be
+    metres: poses of the robot, the part and the calibration target, holes, reference targets
+    and markers beyond :data:`MAX_CELL_COORDINATE_M`; the tool's offset and stand-off beyond
+    :data:`MAX_TOOL_OFFSET_M`."""
+    out: list[Problem] = []
+
+    def coords(field: str, xyz: Any, bound: float, what: str) -> None:
+        worst = max(abs(float(v)) for v in xyz)
+        if worst > bound:
+            out.append((field, list(xyz), f"{what} over {bound:g} m: {HINT}"))
+
+    coords("robot.base.xyz", cfg.robot.base.xyz, MAX_CELL_COORDINATE_M, "a coordinate")
+    coords("part.base.xyz", cfg.part.base.xyz, MAX_CELL_COORDINATE_M, "a coordinate")
+    coords("tool.tool0_to_tcp.xyz", cfg.tool.tool0_to_tcp.xyz, MAX_TOOL_OFFSET_M, "an offset")
+    if cfg.tool.standoff_m > MAX_TOOL_OFFSET_M:
+        out.append(("tool.standoff_m", cfg.tool.standoff_m,
+                    f"a stand-off over {MAX_TOOL_OFFSET_M:g} m: {HINT}"))  # fmt: skip
+    for group in ("part.holes", "reference_targets", "reference_markers"):
+        items = cfg.part.holes if group == "part.holes" else getattr(cfg, group)
+        for i, item in enumerate(items):
+            coords(f"{group}[{i}].position", item.position, MAX_CELL_COORDINATE_M, "a coordinate")
+    if cfg.calibration_target is not None:
+        xyz = cfg.calibration_target.pose.xyz
+        coords("calibration_target.pose.xyz", xyz, MAX_CELL_COORDINATE_M, "a coordinate")
+    return out
