@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -46,7 +47,7 @@ from cell.sim.truth import CellTruth
 from cell.sim.world import SimWorld, WorldOptions
 from measure import MeasurementError, measure_hole
 from measure.synth import render_hole_pair
-from robots.transforms import invert, so3_exp
+from robots.transforms import invert, pose_to_matrix, so3_exp, so3_log
 
 
 def _perturbed(T: np.ndarray, rng: np.random.Generator, mm: float, deg: float) -> np.ndarray:
@@ -62,11 +63,9 @@ def _large(seed: int, cell) -> CellTruth:
 
     def grow(T: np.ndarray) -> np.ndarray:
         out = np.eye(4)
-        out[:3, :3] = so3_exp(3 * _rotvec(T[:3, :3]))
+        out[:3, :3] = so3_exp(3 * so3_log(T[:3, :3]))
         out[:3, 3] = 3 * T[:3, 3]
         return out
-
-    from dataclasses import replace
 
     return replace(
         t,
@@ -75,12 +74,6 @@ def _large(seed: int, cell) -> CellTruth:
         tcp_error=grow(t.tcp_error),
         part_placement_error=grow(t.part_placement_error),
     )
-
-
-def _rotvec(R: np.ndarray) -> np.ndarray:
-    from robots.transforms import so3_log
-
-    return so3_log(R)
 
 
 def run_seed(seed: int, args, cell, stereo) -> dict:
@@ -197,15 +190,9 @@ def _holes(seed, args, cell, stereo, world, head, mt, res, rng) -> dict:
     if ev.placement is None or truth.placement is None:
         return out | {"hole_rms_um": float("nan"), "hole_max_um": float("nan")}
 
-    def T_of(p):
-        from scipy.spatial.transform import Rotation
-
-        T = np.eye(4)
-        T[:3, :3] = Rotation.from_quat(p["quat_xyzw"]).as_matrix()
-        T[:3, 3] = p["xyz"]
-        return invert(T)
-
-    Tm, Tt = T_of(ev.placement["T_fixture_part"]), T_of(truth.placement["T_fixture_part"])
+    # fixture -> part, measured DRF and true DRF
+    Tm = invert(pose_to_matrix(**ev.placement["T_fixture_part"]))
+    Tt = invert(pose_to_matrix(**truth.placement["T_fixture_part"]))
     errs = []
     for r in results:
         nrm = np.asarray(cell.part.holes[r.stop_index].normal, float)

@@ -124,3 +124,20 @@ def so3_left_jacobian(w: ArrayLike) -> Array:
     if th < 1e-8:
         return np.eye(3) + 0.5 * W
     return np.eye(3) + (1 - np.cos(th)) / th**2 * W + (th - np.sin(th)) / th**3 * W @ W
+
+
+def kabsch(P: ArrayLike, Q: ArrayLike) -> tuple[Array, Array, Array]:
+    """Least-squares rigid motion with ``Q ~ R P + t``: ``P (k, 3)`` nominal, ``Q (N, k, 3)``
+    measured; returns R ``(N, 3, 3)``, t ``(N, 3)``, RMS residual ``(N,)`` (m)."""
+    P, Q = np.asarray(P, dtype=float), np.asarray(Q, dtype=float)
+    p0, q0 = P.mean(axis=0), Q.mean(axis=1)
+    H = np.einsum("ki,nkj->nij", P - p0, Q - q0[:, None, :])
+    U, _, Vt = np.linalg.svd(H)
+    d = np.sign(np.linalg.det(np.einsum("nji,nkj->nik", Vt, U)))
+    D = np.zeros((len(d), 3, 3))
+    D[:, 0, 0] = D[:, 1, 1] = 1.0
+    D[:, 2, 2] = d
+    R = np.einsum("nji,njk,nlk->nil", Vt, D, U)
+    t = q0 - R @ p0
+    res = Q - (np.einsum("nij,kj->nki", R, P) + t[:, None, :])
+    return R, t, np.sqrt(np.mean(np.sum(res**2, axis=2), axis=1))

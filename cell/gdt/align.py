@@ -32,7 +32,7 @@ from scipy.optimize import minimize
 
 from cell.config.datums import Datum
 from cell.gdt.errors import GdtError
-from robots.transforms import skew, so3_exp
+from robots.transforms import kabsch, skew, so3_exp
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
@@ -89,22 +89,6 @@ def _basis(z: np.ndarray, x_dir: np.ndarray) -> np.ndarray:
         raise GdtError("tertiary datum", "lies on the normal of the primary through the origin")
     x = x / norm[:, None]
     return np.stack([x, np.cross(z, x), z], axis=2)
-
-
-def kabsch(P: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Least-squares rigid motion with ``Q ~ R P + t``: ``P (k, 3)`` nominal, ``Q (N, k, 3)``
-    measured; returns R ``(N, 3, 3)``, t ``(N, 3)``, RMS residual ``(N,)`` (m)."""
-    p0, q0 = P.mean(axis=0), Q.mean(axis=1)
-    H = np.einsum("ki,nkj->nij", P - p0, Q - q0[:, None, :])
-    U, _, Vt = np.linalg.svd(H)
-    d = np.sign(np.linalg.det(np.einsum("nji,nkj->nik", Vt, U)))
-    D = np.zeros((len(d), 3, 3))
-    D[:, 0, 0] = D[:, 1, 1] = 1.0
-    D[:, 2, 2] = d
-    R = np.einsum("nji,njk,nlk->nil", Vt, D, U)
-    t = q0 - R @ p0
-    res = Q - (np.einsum("nij,kj->nki", R, P) + t[:, None, :])
-    return R, t, np.sqrt(np.mean(np.sum(res**2, axis=2), axis=1))
 
 
 def _minimax_step(P: np.ndarray, Q: np.ndarray, R: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -98,8 +98,9 @@ def markers_seen_per_hole(cell: CellConfig, stereo: StereoCalibration) -> dict[s
     90 deg), empty when they are fewer than 4 or not well spread."""
     ms = cell.reference_markers
     T_cell_part = cell.T_cell_part()
-    P = np.array([marker_in_cell(m, T_cell_part)[0] for m in ms]).reshape(-1, 3)
-    N = np.array([marker_in_cell(m, T_cell_part)[1] for m in ms]).reshape(-1, 3)
+    placed = [marker_in_cell(m, T_cell_part) for m in ms]
+    P = np.array([p for p, _ in placed]).reshape(-1, 3)
+    N = np.array([n for _, n in placed]).reshape(-1, 3)
     out = {}
     for h in cell.part.holes:
         worst: list[str] | None = None

@@ -7,7 +7,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from cell.config.datums import Datum
-from cell.gdt.align import best_fit_frame, datum_frame, kabsch, minimax
+from cell.gdt.align import best_fit_frame, datum_frame, minimax
+from robots.transforms import kabsch
 
 # a plate in the x-z plane at y = 0.167 (normal +y) and two holes off it, like the frame's
 PLATE = {

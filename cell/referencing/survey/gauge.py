@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from robots.transforms import skew
+from robots.transforms import kabsch, make_transform, skew
 
 Array = NDArray[np.float64]
 
@@ -36,14 +36,10 @@ class Gauged:
 
 
 def rigid_fit(P: Array, Q: Array) -> Array:
-    """The rigid transform (4, 4) minimising ``sum |T P_i - Q_i|^2`` (Kabsch)."""
-    cp, cq = P.mean(axis=0), Q.mean(axis=0)
-    U, _, Vt = np.linalg.svd((P - cp).T @ (Q - cq))
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = R, cq - R @ cp
-    return T
+    """The rigid transform (4, 4) minimising ``sum |T P_i - Q_i|^2``
+    (:func:`robots.transforms.kabsch`)."""
+    R, t, _ = kabsch(P, np.asarray(Q, float)[None])
+    return make_transform(R[0], t[0])
 
 
 def gauge_rows(on_fixture: NDArray[np.bool_], nominal: Array) -> tuple[NDArray[np.int64], str]:

@@ -20,8 +20,6 @@ several distances and orientations determine them, and the scale then comes from
 
 from __future__ import annotations
 
-from functools import partial
-
 import gtsam
 import numpy as np
 from gtsam.symbol_shorthand import C, L, R, X, Y
@@ -100,7 +98,7 @@ def _graph(problem: SurveyProblem) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Va
         graph.add(gtsam.GeneralSFMFactor2Cal3DS2(uv, pix, pose, L(j), C(s)))
     tie = gtsam.noiseModel.Isotropic.Sigma(6, RIG_TIE_SIGMA)
     for v in range(problem.n_views):
-        graph.add(gtsam.CustomFactor(tie, [X(v), Y(v), R(0)], partial(_rig_error)))
+        graph.add(gtsam.CustomFactor(tie, [X(v), Y(v), R(0)], _rig_error))
         values.insert(X(v), gtsam.Pose3(problem.poses0[v]))
         values.insert(Y(v), gtsam.Pose3(problem.poses0[v] @ problem.T_left_right))
     for j in range(problem.n_markers):
