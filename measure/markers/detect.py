@@ -26,7 +26,7 @@ import numpy as np
 from measure.image_input import to_gray
 from measure.markers.candidates import DotCandidate, find_dot_candidates, to_8bit
 from measure.markers.design import DEFAULT_DESIGN, MarkerDesign
-from measure.markers.edges import dot_edge_points
+from measure.markers.edges import bilinear, dot_edge_points
 from measure.markers.ellipse import EllipseFit, fit_ellipse
 from measure.markers.ring_read import read_ring, ring_samples
 from measure.markers.tag_read import read_tag
@@ -78,6 +78,18 @@ def _dark_surround(img: np.ndarray, dot: EllipseFit, white: float, black: float)
     return bool(np.quantile(gap, 0.9) < black + 0.25 * (white - black))
 
 
+def _dark_surround_candidate(img: np.ndarray, cand: DotCandidate) -> bool:
+    """Quick test before the edges: darker at 1.3 radii all round than inside the blob."""
+    t = np.linspace(0.0, 2 * np.pi, 36, endpoint=False)
+    c, s = np.cos(cand.angle), np.sin(cand.angle)
+    out, inn = [], []
+    for rho, acc in ((1.3, out), (0.4, inn)):
+        x, y = rho * cand.a * np.cos(t), rho * cand.b * np.sin(t)
+        acc.append(bilinear(img, cand.center[0] + c * x - s * y, cand.center[1] + s * x + c * y))
+    inside = float(np.median(inn[0]))
+    return bool(np.quantile(out[0], 0.9) < 0.5 * inside + 0.5 * float(np.min(out[0])))
+
+
 def _ideal_fit(
     pts: np.ndarray, K: np.ndarray, dist: np.ndarray
 ) -> tuple[EllipseFit, np.ndarray] | None:
@@ -102,11 +114,13 @@ def _measure(
     dist: np.ndarray,
     design: MarkerDesign,
 ) -> MarkerDetection | None:
+    if not _dark_surround_candidate(img, cand):
+        return None
     pts, white, black = dot_edge_points(img, cand, MIN_CONTRAST * full)
     n_rays = int(np.clip(np.pi * (cand.a + cand.b) / 1.5, 48, 720))
     if len(pts) < max(16, MIN_EDGE_FRACTION * n_rays) or white - black < MIN_CONTRAST * full:
         return None
-    raw = fit_ellipse(pts)
+    raw = fit_ellipse(pts, refine=K is None)
     if raw is None or not (0.7 < raw.a / cand.a < 1.4) or raw.b < 0.5 * cand.b:
         return None
     if not _dark_surround(img, raw, white, black):

@@ -1,12 +1,13 @@
 """Sub-pixel edge points of a dot: where the image crosses halfway between the dot's white and
 its surround's black, along rays from the dot's approximate centre.
 
-Each ray is sampled (bilinear, every 0.2 px) from 0.55 to 1.45 times the approximate ellipse's
-radius in its direction; its own white (mean over 0.55-0.75) and black (mean over 1.3-1.45)
-levels set its threshold, so a slow change of light across the dot does not move the edge.
-The crossing nearest to the approximate edge is interpolated linearly. For a Gaussian optics
-blur the half-level crossing of a straight edge is the edge itself; on a circle's image it
-lies inward by about σ²/(2ρ) (ρ the curvature radius), which shrinks the ellipse about its
+Each ray is sampled (bilinear, every 0.2 px) from 0.55 to 1.32 times the approximate ellipse's
+radius in its direction; its own white (mean over 0.55-0.75) and black (mean over 1.18-1.32,
+inside the label's black gap even at 2 px of blur) levels set its threshold, so a slow change
+of light across the dot does not move the edge. The crossing nearest to the approximate edge
+is interpolated linearly. For a Gaussian optics blur the half-level crossing of a straight
+edge is the edge itself; on a circle's image it lies inward by about σ²/(2ρ) (ρ the curvature
+radius), which shrinks the ellipse about its
 centre and leaves the centre.
 """
 
@@ -19,8 +20,8 @@ from measure.markers.candidates import DotCandidate
 #: sample spacing along a ray (px)
 STEP_PX = 0.2
 #: ray span in units of the local radius, and the windows of the white and black levels
-SPAN = (0.55, 1.45)
-WHITE_WIN, BLACK_WIN = (0.55, 0.75), (1.3, 1.45)
+SPAN = (0.55, 1.32)
+WHITE_WIN, BLACK_WIN = (0.55, 0.75), (1.18, 1.32)
 
 
 def bilinear(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -67,15 +68,17 @@ def dot_edge_points(
     above = prof > level[:, None]
     # crossings from above to below the level between samples k and k+1
     cross = above[:, :-1] & ~above[:, 1:]
-    pts = []
-    target = np.argmin(np.abs(frac - 1.0))
-    for i in np.flatnonzero(white - black >= min_contrast):
-        ks = np.flatnonzero(cross[i])
-        if len(ks) == 0:
-            continue
-        k = ks[np.argmin(np.abs(ks - target))]
-        p0, p1 = prof[i, k] - level[i], prof[i, k + 1] - level[i]
-        f = p0 / (p0 - p1)
-        d = dist[i, k] + f * (dist[i, k + 1] - dist[i, k])
-        pts.append(cand.center + d * dirs[i])
-    return np.array(pts).reshape(-1, 2), float(np.median(white)), float(np.median(black))
+    target = int(np.argmin(np.abs(frac - 1.0)))
+    ok = (white - black >= min_contrast) & cross.any(axis=1)
+    # the crossing nearest the approximate edge on each ray
+    ks = np.arange(cross.shape[1])[None, :]
+    far = np.where(cross, np.abs(ks - target), 1 << 30)
+    k = np.argmin(far, axis=1)
+    rows = np.flatnonzero(ok)
+    k = k[rows]
+    p0 = prof[rows, k] - level[rows]
+    p1 = prof[rows, k + 1] - level[rows]
+    f = p0 / (p0 - p1)
+    d = dist[rows, k] + f * (dist[rows, k + 1] - dist[rows, k])
+    pts = cand.center + d[:, None] * dirs[rows]
+    return pts.reshape(-1, 2), float(np.median(white)), float(np.median(black))

@@ -108,13 +108,14 @@ def _gauss_newton(p: np.ndarray, pts: np.ndarray, iters: int) -> tuple[np.ndarra
         except np.linalg.LinAlgError:
             break
         p = p + dp
-        if np.all(np.abs(dp[:4]) < 1e-7):
+        if np.all(np.abs(dp[:4]) < 1e-5):
             break
     return p, JtJ
 
 
-def fit_ellipse(pts: np.ndarray) -> EllipseFit | None:
-    """Fit an ellipse to edge points (n, 2); None when fewer than 8 points or no ellipse."""
+def fit_ellipse(pts: np.ndarray, refine: bool = True) -> EllipseFit | None:
+    """Fit an ellipse to edge points (n, 2); None when fewer than 8 points or no ellipse.
+    ``refine`` False: the direct fit only (no outlier rejection, no covariance: zeros)."""
     pts = np.asarray(pts, dtype=float)
     if len(pts) < 8:
         return None
@@ -128,14 +129,16 @@ def fit_ellipse(pts: np.ndarray) -> EllipseFit | None:
         return None
     cx, cy, a, b, ang = par
     p = np.array([cx * scale + mu[0], cy * scale + mu[1], a * scale, b * scale, ang])
-    p, _ = _gauss_newton(p, pts, 6)
+    if not refine:
+        return EllipseFit(p[:2].copy(), p[2], p[3], ang, np.zeros((2, 2)), 0.0, len(pts))
+    p, _ = _gauss_newton(p, pts, 4)
     r = _sampson(p, pts)
     sigma = 1.4826 * float(np.median(np.abs(r))) + 1e-6
     keep = np.abs(r) < 3.5 * max(sigma, 0.02)
     if keep.sum() < 8:
         return None
     pts = pts[keep]
-    p, JtJ = _gauss_newton(p, pts, 3)
+    p, JtJ = _gauss_newton(p, pts, 2)
     r = _sampson(p, pts)
     rms = float(np.sqrt(np.mean(r * r)))
     dof = max(len(pts) - 5, 1)

@@ -93,29 +93,49 @@ def _tag_white(u, v, ux, uy, vx, vy, field, x0, top, cell) -> float:
 
 
 @njit(cache=True)
-def marker_patch(nx, ny, H, kind, geo, sectors, field, levels, lit, out) -> None:
-    """Draw one marker into ``out`` ((h, w) float32, holding what lies behind the marker).
+def _ray(gnx, gny, gx0, gy0, step, px, py) -> tuple[float, float, float, float, float, float]:
+    """Bilinear ray ``(nx, ny)`` at pixel ``(px, py)`` from grid nodes at ``gx0 + i step``,
+    and its pixel derivatives ``d(nx, ny)/dx``, ``d(nx, ny)/dy`` within the grid cell."""
+    fx, fy = (px - gx0) / step, (py - gy0) / step
+    rows, cols = gnx.shape
+    ix = min(max(math.floor(fx), 0), cols - 2)
+    iy = min(max(math.floor(fy), 0), rows - 2)
+    ax, ay = fx - ix, fy - iy
+    a00, a01, a10, a11 = gnx[iy, ix], gnx[iy, ix + 1], gnx[iy + 1, ix], gnx[iy + 1, ix + 1]
+    b00, b01, b10, b11 = gny[iy, ix], gny[iy, ix + 1], gny[iy + 1, ix], gny[iy + 1, ix + 1]
+    x = (a00 * (1 - ax) + a01 * ax) * (1 - ay) + (a10 * (1 - ax) + a11 * ax) * ay
+    y = (b00 * (1 - ax) + b01 * ax) * (1 - ay) + (b10 * (1 - ax) + b11 * ax) * ay
+    x_x = ((a01 - a00) * (1 - ay) + (a11 - a10) * ay) / step
+    y_x = ((b01 - b00) * (1 - ay) + (b11 - b10) * ay) / step
+    x_y = ((a10 - a00) * (1 - ax) + (a11 - a01) * ax) / step
+    y_y = ((b10 - b00) * (1 - ax) + (b11 - b01) * ax) / step
+    return x, y, x_x, y_x, x_y, y_y
 
-    ``nx``, ``ny`` ((h + 2, w + 2)): the rays ``(nx, ny, 1)`` of ``out``'s pixels with a one-pixel
-    margin; ``H`` maps a ray to homogeneous marker coordinates (dot diameters); rays with
-    ``H[2] . d <= 0`` miss the marker's face. ``geo``: ring ``(r_in, r_out, label_radius)``, tag
-    ``(x_lo, x_hi, y_lo, y_hi, field_x0, field_top, cell)``. ``levels`` = (black, white)
-    reflectance; ``lit`` ((h, w)): illumination.
+
+@njit(cache=True)
+def marker_patch(grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels, lit, out):
+    """Draw one marker into ``out`` ((h, w) float32: the pixels ``box`` = (x0, y0) onward,
+    holding what lies behind the marker).
+
+    ``grid`` (2, rows, cols): exact rays ``(nx, ny)`` at pixel nodes ``(gx0 + i step, gy0 + j
+    step)``, interpolated bilinearly; ``H`` maps a ray to homogeneous marker coordinates (dot
+    diameters); rays with ``H[2] . d <= 0`` miss the marker's face. ``geo``: ring ``(r_in,
+    r_out, label_radius)``, tag ``(x_lo, x_hi, y_lo, y_hi, field_x0, field_top, cell)``.
+    ``levels`` = (black, white) reflectance; ``lit`` ((h, w)): illumination.
     """
     h, w = out.shape
+    gnx, gny = grid[0], grid[1]
     black, white_level = levels[0], levels[1]
     for yy in range(h):
         for xx in range(w):
-            x, y = nx[yy + 1, xx + 1], ny[yy + 1, xx + 1]
+            x, y, rx_x, ry_x, rx_y, ry_y = _ray(
+                gnx, gny, gx0, gy0, step, float(box[0] + xx), float(box[1] + yy)
+            )
             den = H[2, 0] * x + H[2, 1] * y + H[2, 2]
             if den <= 0.0:
                 continue
             u = (H[0, 0] * x + H[0, 1] * y + H[0, 2]) / den
             v = (H[1, 0] * x + H[1, 1] * y + H[1, 2]) / den
-            rx_x = 0.5 * (nx[yy + 1, xx + 2] - nx[yy + 1, xx])
-            ry_x = 0.5 * (ny[yy + 1, xx + 2] - ny[yy + 1, xx])
-            rx_y = 0.5 * (nx[yy + 2, xx + 1] - nx[yy, xx + 1])
-            ry_y = 0.5 * (ny[yy + 2, xx + 1] - ny[yy, xx + 1])
             au, bu = (H[0, 0] - u * H[2, 0]) / den, (H[0, 1] - u * H[2, 1]) / den
             av, bv = (H[1, 0] - v * H[2, 0]) / den, (H[1, 1] - v * H[2, 1]) / den
             ux, uy = au * rx_x + bu * ry_x, au * rx_y + bu * ry_y
@@ -131,12 +151,14 @@ def marker_patch(nx, ny, H, kind, geo, sectors, field, levels, lit, out) -> None
                 if label <= 0.0:
                     continue
                 wc = _disc(r, 0.5, rx, ry, ju2)
-                wc += _ring_white(u, v, ux, uy, vx, vy, r, rx, ry, ju2, sectors, geo[0], geo[1])
+                if wc < 1.0 and r > geo[0] - g:
+                    wc += _ring_white(u, v, ux, uy, vx, vy, r, rx, ry, ju2, sectors, geo[0], geo[1])
             else:
                 label = _band(u, geo[0], geo[1], ux, uy) * _band(v, geo[2], geo[3], vx, vy)
                 if label <= 0.0:
                     continue
                 wc = _disc(r, 0.5, rx, ry, ju2)
-                wc += _tag_white(u, v, ux, uy, vx, vy, field, geo[4], geo[5], geo[6])
+                if wc < 1.0 and u > geo[4] - 2.0 * math.sqrt(ux * ux + uy * uy):
+                    wc += _tag_white(u, v, ux, uy, vx, vy, field, geo[4], geo[5], geo[6])
             refl = black * (label - wc) + white_level * wc
             out[yy, xx] = out[yy, xx] * (1.0 - label) + refl * lit[yy, xx]
