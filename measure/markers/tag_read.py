@@ -1,7 +1,8 @@
 """Identifying a dot by the AprilTag beside it (``apriltag`` design).
 
 OpenCV's ArUco detector (``DICT_APRILTAG_36h11``, sub-pixel corners) runs on a crop around the
-dot that holds the whole label. A tag's four corners give the homography of the marker's plane
+dot that holds the whole label, upsampled (bicubic, up to 4×) when the tag's cells would be
+narrower than ``UPSAMPLE_CELL_PX``. A tag's four corners give the homography of the marker's plane
 (the tag's corners are known in dot diameters), which predicts the dot's centre and size; the
 tag identifies the dot when the prediction lands on the dot's ellipse.
 """
@@ -16,6 +17,9 @@ import numpy as np
 from measure.markers.codes import apriltag_dictionary
 from measure.markers.design import MarkerDesign
 from measure.markers.ellipse import EllipseFit
+
+#: cells narrower than this (px, along the dot's minor axis) are upsampled to it
+UPSAMPLE_CELL_PX = 8.0
 
 
 @lru_cache(maxsize=1)
@@ -42,13 +46,20 @@ def read_tag(gray8: np.ndarray, dot: EllipseFit, design: MarkerDesign) -> tuple[
     y0 = max(int(dot.center[1] - reach), 0)
     x1 = min(int(dot.center[0] + reach) + 1, w)
     y1 = min(int(dot.center[1] + reach) + 1, h)
-    corners, ids, _ = _detector().detectMarkers(gray8[y0:y1, x0:x1])
+    crop = gray8[y0:y1, x0:x1]
+    # the detector needs a few pixels per cell: small or oblique tags are upsampled
+    cell_px = design.tag_cell / 0.5 * dot.b
+    up = int(min(max(np.ceil(UPSAMPLE_CELL_PX / cell_px), 1), 4))
+    if up > 1:
+        crop = cv2.resize(crop, None, fx=up, fy=up, interpolation=cv2.INTER_CUBIC)
+    corners, ids, _ = _detector().detectMarkers(crop)
     if ids is None:
         return None, float("inf")
     plane = tag_corners_plane(design)
     best: tuple[int | None, float] = (None, float("inf"))
     for c, i in zip(corners, ids.ravel(), strict=True):
-        img_pts = c.reshape(4, 2).astype(np.float64) + np.array([x0, y0])
+        # an upsampled pixel centre k is the original's (k + 0.5) / up - 0.5
+        img_pts = (c.reshape(4, 2).astype(np.float64) + 0.5) / up - 0.5 + np.array([x0, y0])
         H = cv2.getPerspectiveTransform(plane.astype(np.float32), img_pts.astype(np.float32))
         p = H @ np.array([0.0, 0.0, 1.0])
         pred = p[:2] / p[2]
