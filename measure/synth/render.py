@@ -10,6 +10,7 @@ given fresh shot and read noise.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import cv2
@@ -17,6 +18,7 @@ import numpy as np
 
 from measure.calibration import StereoCalibration
 from measure.synth.hole_scene import HoleGeometry, Shading, shade
+from measure.synth.marker_draw import MarkerPatch, draw_markers
 from measure.synth.optics import ray_grid, vignetting
 from measure.synth.texture import TEXEL_M, TILE_CENTER_M, background_noise, sample_texture
 
@@ -268,7 +270,9 @@ def _camera_output(img: np.ndarray, opts: RenderOptions, win, rng) -> np.ndarray
     return out
 
 
-def _render_side(stereo, side, geo, sh, opts, rng) -> tuple[np.ndarray, tuple[int, int, int, int]]:
+def _render_side(
+    stereo, side, geo, sh, opts, rng, markers=()
+) -> tuple[np.ndarray, tuple[int, int, int, int]]:
     img = _background(stereo, side, geo, sh, opts.vignetting)
     r_win = (1.75 if opts.highlight > 0 else 1.2) * geo.radius + 2.0 * geo.chamfer + 1e-3
     win = _window(stereo, side, geo, r_win)
@@ -278,6 +282,8 @@ def _render_side(stereo, side, geo, sh, opts, rng) -> tuple[np.ndarray, tuple[in
         big = (x0 - margin, y0 - margin, w + 2 * margin, h + 2 * margin)
         patch = _render_window(stereo, side, geo, sh, opts, big)
         img[y0 : y0 + h, x0 : x0 + w] = patch[margin : margin + h, margin : margin + w]
+    if markers:  # labels stuck on the surface, drawn over it
+        draw_markers(img, stereo, side, markers, opts.blur_sigma_px, opts.vignetting)
     if opts.light_gradient:
         _uneven(img, opts.light_gradient, sh.light_azimuth)
     return _camera_output(img, opts, win, rng), win
@@ -305,6 +311,7 @@ def render_hole_pair(
     diameter_m: float,
     options: RenderOptions | None = None,
     seed: int = 0,
+    markers: Sequence[MarkerPatch] = (),
 ) -> StereoRender:
     """Render the left and right images of one hole, with exact truth.
 
@@ -315,6 +322,8 @@ def render_hole_pair(
         diameter_m: bore diameter (metres).
         options: appearance and noise (:class:`RenderOptions`).
         seed: seeds texture placement, highlight/burr azimuth and noise.
+        markers: reference markers in view (LEFT camera frame), drawn over the surface
+            (:mod:`measure.synth.marker_draw`); none: the images are as without the argument.
 
     Returns:
         :class:`StereoRender` with ``uint8`` (8-bit) or ``uint16`` (12-bit) images. A hole
@@ -354,8 +363,9 @@ def render_hole_pair(
         ),
         **_realism(opts, r, depth, rng),
     )
-    left, win_l = _render_side(stereo, "left", geo, sh, opts, rng)
-    right, win_r = _render_side(stereo, "right", geo.transformed(stereo.R, stereo.T), sh, opts, rng)
+    left, win_l = _render_side(stereo, "left", geo, sh, opts, rng, markers)
+    geo_r = geo.transformed(stereo.R, stereo.T)
+    right, win_r = _render_side(stereo, "right", geo_r, sh, opts, rng, markers)
     truth = HoleTruth(
         center_m=c.copy(),
         normal=n.copy(),
@@ -376,6 +386,7 @@ def render_reference_pair(
     diameter_m: float = 0.010,
     options: RenderOptions | None = None,
     seed: int = 0,
+    markers: Sequence[MarkerPatch] = (),
 ) -> StereoRender:
     """Render a reference target: a precision bore (sharp rim, fine texture) in a gauge plate.
 
@@ -386,4 +397,4 @@ def render_reference_pair(
     opts = replace(
         base, chamfer_m=0.0, highlight=0.0, occlusion_fraction=0.0, texture_amplitude=0.015
     )
-    return render_hole_pair(stereo, center_m, normal, diameter_m, opts, seed)
+    return render_hole_pair(stereo, center_m, normal, diameter_m, opts, seed, markers)
