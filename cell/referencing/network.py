@@ -48,10 +48,11 @@ def load_network(
     path: str | Path,
     cell: CellConfig,
     stereo: StereoCalibration,
-    max_age_days: float = MAX_AGE_DAYS,
+    max_age_days: float | None = MAX_AGE_DAYS,
 ) -> MarkerNetwork:
     """``markers.json`` of ``cell`` surveyed with ``stereo`` (refused, one line naming the
-    field, when it belongs to another cell, marker layout or head, or is too old)."""
+    field, when it belongs to another cell, marker layout or head, or is too old; any age
+    with ``max_age_days`` None)."""
     src = str(path)
     doc, ids, P, C = load_markers(path)
     check_markers(doc, src, cell, stereo, max_age_days)
