@@ -128,6 +128,12 @@ def draw_marker(
     px = cv2.projectPoints(P, np.zeros(3), np.zeros(3), K, dist)[0].reshape(-1, 2)
     margin = math.ceil(3.0 * blur_sigma_px) + 3
     w_img, h_img = stereo.image_size
+    # the lens polynomial folds points far outside the field back into the image: where the
+    # pinhole image lies well outside, the outline point's pixel is the pinhole one
+    pin = (P[:, :2] / P[:, 2:3]) @ np.asarray(K)[:2, :2].T + np.asarray(K)[:2, 2]
+    far = ((pin[:, 0] < -0.1 * w_img) | (pin[:, 0] > 1.1 * w_img)
+           | (pin[:, 1] < -0.1 * h_img) | (pin[:, 1] > 1.1 * h_img))  # fmt: skip
+    px[far] = pin[far]
     x0, y0 = np.floor(px.min(axis=0)).astype(int) - 2 * margin
     x1, y1 = np.ceil(px.max(axis=0)).astype(int) + 2 * margin + 1
     x0, y0, x1, y1 = max(x0, 0), max(y0, 0), min(x1, w_img), min(y1, h_img)
@@ -158,6 +164,8 @@ def draw_marker(
     iy0 = margin if y0 > 0 else 0
     ix1 = w - margin if x1 < w_img else w
     iy1 = h - margin if y1 < h_img else h
+    if ix1 <= ix0 or iy1 <= iy0:
+        return None
     img[y0 + iy0 : y0 + iy1, x0 + ix0 : x0 + ix1] = patch[iy0:iy1, ix0:ix1]
     return (int(x0 + ix0), int(y0 + iy0), int(ix1 - ix0), int(iy1 - iy0))
 
