@@ -20,6 +20,7 @@ from cell.config.datums import Alignment, Datum, Tolerances
 from cell.config.markers import ReferenceMarker, ScaleBar
 from cell.config.pose import IDENTITY, Pose, Positive, Vec3, _Strict, unit_normal
 from cell.config.shapes import ShapeSpec
+from cell.config.step_part import StepSpec
 from cell.config.target import CalibrationTargetBoard
 from cell.uncertainty.materials import (
     BUILTIN_MATERIALS,
@@ -29,6 +30,7 @@ from cell.uncertainty.materials import (
     material_field,
 )
 from robots import DEFAULT_MODEL, Arm, LimitScaling, Shape
+from robots.meshes import TriangleMesh
 
 JointRange = Annotated[list[float], Field(min_length=2, max_length=2)]
 
@@ -84,6 +86,8 @@ class Part(_Strict):
     holes: list[Hole] = []
     #: more holes from a CSV, relative to the cell file (:mod:`cell.config.holes_csv`)
     holes_csv: str | None = None
+    #: holes, drawing and mesh from the part's STEP file (:mod:`cell.config.step_part`)
+    step: StepSpec | None = None
     obstacles: list[ShapeSpec] = []
     #: a built-in name or {name, alpha_per_K, u_alpha_per_K}; None: steel assumed
     material: MaterialSpec | None = None
@@ -99,6 +103,9 @@ class Part(_Strict):
     alignment: Alignment | None = None
 
     _material = field_validator("material", mode="before")(lambda cls, v: material_field(v))
+    _step = field_validator("step", mode="before")(
+        lambda cls, v: {"path": v} if isinstance(v, str) else v
+    )
 
 
 class Environment(_Strict):
@@ -151,6 +158,8 @@ class CellConfig(_Strict):
 
     _source_path: Path | None = PrivateAttr(default=None)
     _raw_text: str = PrivateAttr(default="")
+    #: the part's mesh tessellated from ``part.step`` (m, part frame), when asked for
+    _step_mesh: TriangleMesh | None = PrivateAttr(default=None)
 
     @property
     def source_path(self) -> Path | None:
@@ -206,6 +215,8 @@ class CellConfig(_Strict):
         """Part and environment obstacles and the calibration plate, poses in the cell frame."""
         T_part, d = self.T_cell_part(), self.base_dir
         part = [s.to_shape(T_part, f"part{i}", d) for i, s in enumerate(self.part.obstacles)]
+        if self._step_mesh is not None:
+            part.append(Shape("mesh", (), T_part, "part_step", self._step_mesh))
         env = [
             s.to_shape(np.eye(4), f"env{i}", d) for i, s in enumerate(self.environment.obstacles)
         ]
