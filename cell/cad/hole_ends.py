@@ -1,124 +1,143 @@
-"""The two ends of a hole: open or closed, how far the axis is free beyond each, and where the
-axis crosses the part's surface there (the centre of the entry and exit circles).
+"""The two ends of a hole: open or closed, where the axis crosses the part's surface there
+(the centre of the entry or exit circle), and whether that surface is concave (the inside of
+a tube: a camera there would stand inside the part).
 
-Shape units (OpenCascade's millimetres). An end is *closed* when a ray cast from it outward
-along the axis meets the part within 0.6 diameters (a flat bottom at once, a drill point of
-118 degrees at 0.3 d); otherwise it is open and the ray's free length is how far a camera
-could look in along the axis (capped at ``clear``).
+Shape units (OpenCascade's millimetres). Topology decides, no ray is cast: at each end the
+*end face* is the face around the hole whose surface the axis crosses outermost on that half
+of the hole. The end is closed when that face's outer boundary is made of the hole's own
+edges only (a flat bottom: a disc bounded by the wall's circle) or when nothing is there (a
+drill point ends in the cone's apex); otherwise the hole opens into the face.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 from OCP.BRep import BRep_Tool
+from OCP.BRepTools import BRepTools
 from OCP.collections import (
     IndexedDataMap_TopoDS_Shape_List_TopoDS_Shape_TopTools_ShapeMapHasher as EdgeFaces,
 )
-from OCP.collections import IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as FaceMap
+from OCP.collections import IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as ShapeMap
 from OCP.Geom import Geom_Line
 from OCP.GeomAPI import GeomAPI_IntCS
 from OCP.gp import gp_Dir, gp_Lin, gp_Pnt
-from OCP.IntCurvesFace import IntCurvesFace_ShapeIntersector
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 
 from cell.cad.axes import Chain
+from cell.cad.cylinders import AxialFace
 
-#: a closed end's bottom lies within this many diameters of it
-BOTTOM_DIAMETERS = 0.6
-#: the ray starts this far inside the hole (shape units)
-EPS = 1e-3
+#: axis crossings this far outside the hole's extent still count (shape units)
+MARGIN = 1e-3
 
 
 @dataclass(frozen=True)
 class End:
     """One end of a chain: ``sign`` +1 for the end at the high ``t``, -1 for the low one;
-    ``t`` its axial coordinate; ``free`` the free length beyond it along the axis (inf when
-    the ray leaves the part), ``open`` whether a camera sees into the hole from there."""
+    ``t`` the axial coordinate of the crossing with the end face (the wall's end when none);
+    ``open`` whether the hole opens there; ``concave`` whether the end face is the inside of
+    a cylinder or cone (a tube's bore); ``radius`` the bore's there."""
 
     sign: float
     t: float
-    free: float
     open: bool
+    concave: bool
     radius: float
 
 
 class ShapeProbe:
-    """Ray casts and face neighbours on one shape, set up once."""
+    """Face adjacency, outer boundaries and surfaces of one shape, set up once."""
 
-    def __init__(self, shape: TopoDS_Shape, faces: FaceMap) -> None:
+    def __init__(self, shape: TopoDS_Shape, faces: ShapeMap, axial: list[AxialFace]) -> None:
         self.faces = faces
-        self.rays = IntCurvesFace_ShapeIntersector()
-        self.rays.Load(shape, 1e-7)
-        self.edge_faces = EdgeFaces()
-        TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, self.edge_faces)
-
-    def free_length(self, start: np.ndarray, direction: np.ndarray) -> float:
-        """Distance from ``start`` along ``direction`` to the first face met (inf: none)."""
-        line = gp_Lin(gp_Pnt(*start), gp_Dir(*direction))
-        self.rays.Perform(line, 0.0, math.inf)
-        if not self.rays.IsDone() or self.rays.NbPnt() == 0:
-            return math.inf
-        return min(self.rays.WParameter(i) for i in range(1, self.rays.NbPnt() + 1))
+        self.edges = ShapeMap()
+        TopExp.MapShapes_s(shape, TopAbs_EDGE, self.edges)
+        edge_faces = EdgeFaces()
+        TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
+        self.face_edges: dict[int, set[int]] = {}
+        self.edge_faces: dict[int, set[int]] = {}
+        for i in range(1, edge_faces.Extent() + 1):
+            e = self.edges.FindIndex(edge_faces.FindKey(i))
+            fs = {faces.FindIndex(f) for f in edge_faces.FindFromIndex(i)}
+            self.edge_faces[e] = fs
+            for f in fs:
+                self.face_edges.setdefault(f, set()).add(e)
+        self.internal = {a.index for a in axial if a.internal}
+        self._outer: dict[int, set[int]] = {}
 
     def neighbours(self, indices: set[int]) -> set[int]:
         """Face numbers sharing an edge with the faces ``indices``, those left out."""
         out: set[int] = set()
         for i in indices:
-            ex = TopExp_Explorer(self.faces.FindKey(i), TopAbs_EDGE)
-            while ex.More():
-                for f in self.edge_faces.FindFromKey(ex.Current()):
-                    out.add(self.faces.FindIndex(f))
-                ex.Next()
+            for e in self.face_edges.get(i, ()):
+                out |= self.edge_faces[e]
         return out - indices
 
-    def axis_crossings(self, faces: set[int], origin: np.ndarray, direction: np.ndarray) -> list[float]:
-        """Where the axis line crosses the surfaces of ``faces`` (axial coordinates)."""
+    def outer_edges(self, face: int) -> set[int]:
+        """Edge numbers of the outer boundary of face ``face``."""
+        if face not in self._outer:
+            wire = BRepTools.OuterWire_s(TopoDS.Face(self.faces.FindKey(face)))
+            found: set[int] = set()
+            ex = TopExp_Explorer(wire, TopAbs_EDGE)
+            while ex.More():
+                found.add(self.edges.FindIndex(ex.Current()))
+                ex.Next()
+            self._outer[face] = found
+        return self._outer[face]
+
+    def axis_crossings(
+        self, faces: set[int], origin: np.ndarray, direction: np.ndarray
+    ) -> list[tuple[float, int]]:
+        """Where the axis line crosses the surfaces of ``faces``: (axial coordinate, face)."""
         line = Geom_Line(gp_Lin(gp_Pnt(*origin), gp_Dir(*direction)))
-        ts: list[float] = []
-        for i in faces:
+        found: list[tuple[float, int]] = []
+        for i in sorted(faces):
             surface = BRep_Tool.Surface_s(TopoDS.Face(self.faces.FindKey(i)))
             inter = GeomAPI_IntCS(line, surface)
             if not inter.IsDone():
                 continue
             for k in range(1, inter.NbPoints() + 1):
                 p = inter.Point(k)
-                ts.append(float(np.dot(np.array([p.X(), p.Y(), p.Z()]) - origin, direction)))
-        return ts
+                t = float(np.dot(np.array([p.X(), p.Y(), p.Z()]) - origin, direction))
+                found.append((t, i))
+        return found
 
 
-def chain_ends(probe: ShapeProbe, chain: Chain, clear: float) -> tuple[End, End]:
-    """The low and the high end of ``chain``; ``clear`` caps the free lengths."""
-    lo, hi = chain.t_range
-    ends = []
-    for sign, t in ((-1.0, lo), (1.0, hi)):
-        end_bore = chain.bores[0] if sign < 0 else chain.bores[-1]
-        start = chain.origin + (t - sign * EPS) * chain.direction
-        free = probe.free_length(start, sign * chain.direction) - EPS
-        closed = free < BOTTOM_DIAMETERS * 2.0 * end_bore.radius
-        ends.append(End(sign, t, min(free, clear), not closed, end_bore.radius))
-    return ends[0], ends[1]
-
-
-def surface_crossing(probe: ShapeProbe, chain: Chain, sign: float) -> float | None:
-    """The axial coordinate where the hole's axis leaves the part at its ``sign`` end: the
-    crossing of the axis with the surfaces around the hole that lies outermost within the
-    half of the chain's extent at that end (an angled face: the middle of the ellipse; a
-    tube: its outer wall)."""
+def end_face(probe: ShapeProbe, chain: Chain, sign: float) -> tuple[float, int] | None:
+    """The crossing (axial coordinate, face) of the axis with the face around the hole that
+    lies outermost on the ``sign`` half of the chain (an angled face: the middle of the
+    ellipse; a tube: its wall), or None when no face around the hole crosses there."""
     lo, hi = chain.t_range
     mid = 0.5 * (lo + hi)
-    # the crossings on this end's half of the hole (the other half is the other end's)
     lo, hi = (mid, hi) if sign > 0 else (lo, mid)
     around = probe.neighbours(chain.face_indices())
-    ts = [
-        t
-        for t in probe.axis_crossings(around, chain.origin, chain.direction)
-        if lo - 1e-3 <= t <= hi + 1e-3
+    hits = [
+        (t, f)
+        for t, f in probe.axis_crossings(around, chain.origin, chain.direction)
+        if lo - MARGIN <= t <= hi + MARGIN
     ]
-    if not ts:
+    if not hits:
         return None
-    return max(ts) if sign > 0 else min(ts)
+    return max(hits) if sign > 0 else min(hits)
+
+
+def chain_ends(probe: ShapeProbe, chain: Chain) -> tuple[End, End]:
+    """The low and the high end of ``chain`` (module doc)."""
+    lo, hi = chain.t_range
+    walls = set()
+    for i in chain.face_indices():
+        walls |= probe.face_edges.get(i, set())
+    ends = []
+    for sign, t_wall in ((-1.0, lo), (1.0, hi)):
+        bore = chain.bores[0] if sign < 0 else chain.bores[-1]
+        crossing = end_face(probe, chain, sign)
+        if crossing is None:
+            ends.append(End(sign, t_wall, False, False, bore.radius))
+            continue
+        t, face = crossing
+        closed = probe.outer_edges(face) <= walls
+        ends.append(End(sign, t, not closed, face in probe.internal, bore.radius))
+    return ends[0], ends[1]

@@ -7,9 +7,10 @@ Left out, and counted: external cylinders (bosses, shafts, the outside of a tube
 cylinders that do not go all the way round (fillets, slots, half holes at an edge) and walls
 closed at both ends (an enclosed void no camera sees).
 
-The entry side: of the open ends, the one with the longer free view along the axis (capped at
-``clear_m``, 0.3 m: beyond that both are as good), then the wider bore (a counterbore's side),
-then the one whose normal points most along +z, +x, +y of the part. The *measured* diameter
+The entry side (:mod:`cell.cad.hole_ends` finds the ends): of the open ends, one on a surface
+that is not concave (a tube's outer wall, not the side facing into the tube), then the wider
+bore (a counterbore's side), then the one whose normal points most along +z, then +x, then +y
+of the part. No ray is cast: whether the camera can stand there is the planner's question. The *measured* diameter
 is the entry bore's (the rim the camera sees at the surface); the other bores are listed.
 Depth: from the entry surface to the exit surface (through) or to the end of the innermost
 cylindrical wall (blind: a drill point below it is not counted).
@@ -25,12 +26,8 @@ from OCP.TopoDS import TopoDS_Shape
 
 from cell.cad.axes import Bore, Chain, chains
 from cell.cad.cylinders import axial_faces, face_map
-from cell.cad.hole_ends import ShapeProbe, chain_ends, surface_crossing
+from cell.cad.hole_ends import End, ShapeProbe, chain_ends
 from cell.cad.step_read import MM_TO_M
-
-#: free view along the axis beyond which both ends count as open alike (m)
-CLEAR_M = 0.3
-
 
 @dataclass(frozen=True)
 class BoreSize:
@@ -68,16 +65,16 @@ class HoleScan:
     left_out: dict[str, int] = field(default_factory=dict)
 
 
-def _entry_sign(low, high) -> float | None:  # noqa: ANN001 - hole_ends.End
-    """+1 or -1: the end the camera looks in from (module doc), None when both are closed."""
+def _entry_sign(low: End, high: End) -> float | None:
+    """+1 or -1: the end the camera looks in from (module doc); None: a tie, or both closed."""
     opened = [e for e in (low, high) if e.open]
     if not opened:
         return None
     if len(opened) == 1:
         return opened[0].sign
 
-    def key(e) -> tuple[float, float]:  # noqa: ANN001
-        return (round(e.free, 6), round(e.radius, 6))
+    def key(e: End) -> tuple[bool, float]:
+        return (not e.concave, round(e.radius, 6))
 
     return None if key(low) == key(high) else max(opened, key=key).sign
 
@@ -90,31 +87,28 @@ def _tie_break(direction: np.ndarray) -> float:
     return 1.0
 
 
-def _hole(probe: ShapeProbe, chain: Chain, clear: float) -> CadHole | None:
-    low, high = chain_ends(probe, chain, clear)
+def _hole(probe: ShapeProbe, chain: Chain) -> CadHole | None:
+    low, high = chain_ends(probe, chain)
     if not (low.open or high.open):
         return None
     sign = _entry_sign(low, high)
     if sign is None:
         sign = _tie_break(chain.direction)
-    t_entry = surface_crossing(probe, chain, sign)
-    t_end = (high if sign > 0 else low).t
-    t_entry = t_end if t_entry is None else t_entry
+    entry, exit_ = (high, low) if sign > 0 else (low, high)
     through = low.open and high.open
     bores: list[Bore] = chain.bores if sign < 0 else chain.bores[::-1]
     if through:
-        t_exit = surface_crossing(probe, chain, -sign)
-        t_exit = (low if sign > 0 else high).t if t_exit is None else t_exit
+        t_exit = exit_.t
     else:
         t_exit = bores[-1].t_range[0] if sign > 0 else bores[-1].t_range[1]
     normal = sign * chain.direction
-    entry = (chain.origin + t_entry * chain.direction) * MM_TO_M
+    centre = (chain.origin + entry.t * chain.direction) * MM_TO_M
     return CadHole(
         id="",
-        entry_m=(float(entry[0]), float(entry[1]), float(entry[2])),
+        entry_m=(float(centre[0]), float(centre[1]), float(centre[2])),
         normal=(float(normal[0]) + 0.0, float(normal[1]) + 0.0, float(normal[2]) + 0.0),
         diameter_m=2.0 * bores[0].radius * MM_TO_M,
-        depth_m=abs(t_entry - t_exit) * MM_TO_M,
+        depth_m=abs(entry.t - t_exit) * MM_TO_M,
         through=through,
         bores=tuple(
             BoreSize(2.0 * b.radius * MM_TO_M, (b.t_range[1] - b.t_range[0]) * MM_TO_M)
@@ -125,16 +119,16 @@ def _hole(probe: ShapeProbe, chain: Chain, clear: float) -> CadHole | None:
     )
 
 
-def find_holes(shape: TopoDS_Shape, clear_m: float = CLEAR_M, prefix: str = "H") -> HoleScan:
+def find_holes(shape: TopoDS_Shape, prefix: str = "H") -> HoleScan:
     """The holes of ``shape`` (OpenCascade, mm), numbered ``H1``... in the order of their
     entry centres (x, then y, then z, to the micrometre)."""
     faces = face_map(shape)
     axial = axial_faces(faces)
     found, partial = chains(axial)
-    probe = ShapeProbe(shape, faces)
+    probe = ShapeProbe(shape, faces, axial)
     holes, enclosed = [], 0
     for chain in found:
-        hole = _hole(probe, chain, clear_m / MM_TO_M)
+        hole = _hole(probe, chain)
         if hole is None:
             enclosed += 1
         else:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from cell.cad.holes import CLEAR_M, CadHole, HoleScan, find_holes
+from cell.cad.holes import CadHole, HoleScan, find_holes
 from cell.cad.mesh import ANGLE_RAD, DEFLECTION_M, tessellate
 from cell.cad.pmi import Pmi, read_pmi
 from cell.cad.step_read import read_step
@@ -38,13 +38,12 @@ def import_step(
     mesh: bool = True,
     deflection_m: float = DEFLECTION_M,
     angle_rad: float = ANGLE_RAD,
-    clear_m: float = CLEAR_M,
 ) -> ImportedPart:
     """Read ``path``: holes, PMI matched to them, and (``mesh``) the tessellated part."""
     t0 = time.perf_counter()
     doc = read_step(path)
     t1 = time.perf_counter()
-    scan = find_holes(doc.shape, clear_m)
+    scan = find_holes(doc.shape)
     t2 = time.perf_counter()
     pmi = read_pmi(doc, scan.holes)
     t3 = time.perf_counter()
