@@ -29,6 +29,12 @@ from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 from OCP.XCAFDimTolObjects import (
+    XCAFDimTolObjects_DimensionType_CommonLabel as COMMON_LABEL,
+)
+from OCP.XCAFDimTolObjects import (
+    XCAFDimTolObjects_DimensionType_DimensionPresentation as PRESENTATION,
+)
+from OCP.XCAFDimTolObjects import (
     XCAFDimTolObjects_DimensionType_Size_Diameter as SIZE_DIAMETER,
 )
 from OCP.XCAFDimTolObjects import (
@@ -160,14 +166,21 @@ def read_pmi(doc: StepDocument, holes: list[CadHole]) -> Pmi:
     """The PMI of ``doc`` matched to ``holes`` (module doc)."""
     gdt = XCAFDoc_DocumentTool.DimTolTool_s(doc.doc.Main())
     tol_labels = _labels(gdt.GetGeomToleranceLabels)
-    dim_labels = _labels(gdt.GetDimensionLabels)
+    all_dims = _labels(gdt.GetDimensionLabels)
+    dim_labels = [d for d in all_dims if not _graphical(d)]
     datum_labels = _labels(gdt.GetDatumLabels)
     pmi = Pmi(semantic=bool(tol_labels or dim_labels or datum_labels))
     pmi.counts = {
         "geometric tolerances": len(tol_labels),
         "dimensions": len(dim_labels),
         "datum labels": len(datum_labels),
+        "graphical only": len(all_dims) - len(dim_labels),
     }
+    if pmi.counts["graphical only"]:
+        pmi.unmodelled.append(
+            f"{pmi.counts['graphical only']} graphical annotations (presentation only, no "
+            "semantic value)"
+        )
     if not pmi.semantic:
         return pmi
     geo = _Faces(doc)
@@ -177,6 +190,12 @@ def read_pmi(doc: StepDocument, holes: list[CadHole]) -> Pmi:
     for lab in dim_labels:
         _dimension(lab, geo, holes, pmi)
     return pmi
+
+
+def _graphical(label: TDF_Label) -> bool:
+    """Whether a dimension label is presentation only (a drawn annotation without values)."""
+    kind = _attr(label, XCAFDoc_Dimension).GetObject().GetType()
+    return kind in (PRESENTATION, COMMON_LABEL)
 
 
 def _tolerance(gdt, lab, geo: _Faces, holes, datums: set[str], pmi: Pmi) -> None:  # noqa: ANN001

@@ -84,6 +84,8 @@ def run_import_step(args: argparse.Namespace) -> int:
     pmi = part.pmi
     if not pmi.semantic:
         print("  no semantic PMI in the file: no datums or tolerances imported")
+        for line in pmi.unmodelled:
+            print(f"    - {line}")
     else:
         n_tol = sum(len(v) for v in tolerances.values())
         print(
