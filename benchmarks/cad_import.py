@@ -25,7 +25,7 @@ from cell.cad.part import import_step
 from cell.config.step_part import drawing
 
 
-def _plate(n: int, folder: Path):  # noqa: ANN202
+def _plate(n: int, folder: Path):
     import sys
 
     sys.path.insert(0, str(Path(__file__).parents[1] / "tests" / "cad"))
@@ -57,7 +57,7 @@ def _plate(n: int, folder: Path):  # noqa: ANN202
     return path, truth, time.perf_counter() - t0
 
 
-def _errors(found, truth) -> tuple[int, float, float, float, float]:  # noqa: ANN001
+def _errors(found, truth) -> tuple[int, float, float, float, float]:
     """Holes matched, worst entry error (um), normal (deg), diameter (um), depth (um)."""
     pos = np.array([h.entry_m for h in found])
     worst = [0.0, 0.0, 0.0, 0.0]

@@ -53,13 +53,16 @@ def main() -> None:
         t_mcap = time.perf_counter() - t0
         q_mcap = np.array([p.positions for p in got["/joint_trajectory"].points])
         q_disp = np.array(
-            [p.positions for p in got["/display_planned_path"].trajectory[0].joint_trajectory.points]
+            [
+                p.positions
+                for p in got["/display_planned_path"].trajectory[0].joint_trajectory.points
+            ]
         )
         store = get_typestore(Stores.ROS2_HUMBLE)
         t0 = time.perf_counter()
         with Reader(bag) as r:
             conn = [c for c in r.connections if c.topic == "/joint_trajectory"]
-            traj = [store.deserialize_cdr(raw, c.msgtype) for c, _, raw in r.messages(conn)][0]
+            traj = next(store.deserialize_cdr(raw, c.msgtype) for c, _, raw in r.messages(conn))
         t_rosbags = time.perf_counter() - t0
         q_rosbags = np.array([p.positions for p in traj.points])
     print(f"tour: {len(tour.stops)} stops, {len(rows)} trajectory rows at dt {tour.dt} s, "

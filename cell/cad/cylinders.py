@@ -52,7 +52,7 @@ def face_map(shape: TopoDS_Shape) -> IndexedMap_TopoDS_Shape_TopTools_ShapeMapHa
     return faces
 
 
-def _vec(d) -> np.ndarray:  # noqa: ANN001 - gp_Dir / gp_Pnt / gp_Vec
+def _vec(d) -> np.ndarray:
     return np.array([d.X(), d.Y(), d.Z()])
 
 
@@ -62,7 +62,7 @@ def canonical(direction: np.ndarray) -> float:
     return 1.0 if direction[k] > 0 else -1.0
 
 
-def _axial(index: int, face, kind: str) -> AxialFace | None:  # noqa: ANN001 - TopoDS_Face
+def _axial(index: int, face, kind: str) -> AxialFace | None:
     surf = BRepAdaptor_Surface(face)
     stype = surf.GetType()
     if stype not in (GeomAbs_Cylinder, GeomAbs_Cone):

@@ -10,15 +10,15 @@ closed at both ends (an enclosed void no camera sees).
 The entry side (:mod:`cell.cad.hole_ends` finds the ends): of the open ends, one on a surface
 that is not concave (a tube's outer wall, not the side facing into the tube), then the wider
 bore (a counterbore's side), then the one whose normal points most along +z, then +x, then +y
-of the part. No ray is cast: whether the camera can stand there is the planner's question. The *measured* diameter
-is the entry bore's (the rim the camera sees at the surface); the other bores are listed.
+of the part. No ray is cast: whether the camera can stand there is the planner's question.
+The *measured* diameter is the entry bore's (the rim the camera sees at the surface); the other
+bores are listed.
 Depth: from the entry surface to the exit surface (through) or to the end of the innermost
 cylindrical wall (blind: a drill point below it is not counted).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,6 +28,7 @@ from cell.cad.axes import Bore, Chain, chains
 from cell.cad.cylinders import axial_faces, face_map
 from cell.cad.hole_ends import End, ShapeProbe, chain_ends
 from cell.cad.step_read import MM_TO_M
+
 
 @dataclass(frozen=True)
 class BoreSize:
@@ -97,10 +98,8 @@ def _hole(probe: ShapeProbe, chain: Chain) -> CadHole | None:
     entry, exit_ = (high, low) if sign > 0 else (low, high)
     through = low.open and high.open
     bores: list[Bore] = chain.bores if sign < 0 else chain.bores[::-1]
-    if through:
-        t_exit = exit_.t
-    else:
-        t_exit = bores[-1].t_range[0] if sign > 0 else bores[-1].t_range[1]
+    inner_end = bores[-1].t_range[0] if sign > 0 else bores[-1].t_range[1]
+    t_exit = exit_.t if through else inner_end
     normal = sign * chain.direction
     centre = (chain.origin + entry.t * chain.direction) * MM_TO_M
     return CadHole(

@@ -72,9 +72,7 @@ def write_stl(mesh: TriangleMesh, path: str | Path, scale: float = 1.0) -> Path:
     normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     lengths = np.linalg.norm(normals, axis=1, keepdims=True)
     normals = np.divide(normals, lengths, out=np.zeros_like(normals), where=lengths > 0)
-    records = np.zeros(
-        len(tri), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")]
-    )
+    records = np.zeros(len(tri), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
     records["n"], records["v"] = normals, tri
     with p.open("wb") as fh:
         fh.write(b"holecell import-step".ljust(80, b" "))

@@ -46,8 +46,13 @@ from OCP.XCAFDimTolObjects import (
 from OCP.XCAFDimTolObjects import (
     XCAFDimTolObjects_GeomToleranceType_Position as POSITION,
 )
-from OCP.XCAFDoc import XCAFDoc_Datum, XCAFDoc_Dimension, XCAFDoc_DimTolTool, XCAFDoc_DocumentTool
-from OCP.XCAFDoc import XCAFDoc_GeomTolerance
+from OCP.XCAFDoc import (
+    XCAFDoc_Datum,
+    XCAFDoc_Dimension,
+    XCAFDoc_DimTolTool,
+    XCAFDoc_DocumentTool,
+    XCAFDoc_GeomTolerance,
+)
 
 from cell.cad.cylinders import face_map
 from cell.cad.holes import CadHole
@@ -79,13 +84,13 @@ def _attr(label: TDF_Label, cls: type) -> Any:
     return None
 
 
-def _labels(getter) -> list[TDF_Label]:  # noqa: ANN001 - a DimTolTool method
+def _labels(getter) -> list[TDF_Label]:
     seq = Sequence_TDF_Label()
     getter(seq)
     return [seq.Value(i + 1) for i in range(seq.Length())]
 
 
-def _name(obj) -> str:  # noqa: ANN001 - an XCAFDimTolObjects object
+def _name(obj) -> str:
     n = obj.GetSemanticName()
     return "" if n is None else n.ToCString()
 
@@ -144,7 +149,7 @@ def _datum_feature(
     return None, "not on a hole or a plane" if faces else "attached to no face"
 
 
-def _datums(gdt, geo: _Faces, holes: list[CadHole], pmi: Pmi) -> set[str]:  # noqa: ANN001
+def _datums(gdt, geo: _Faces, holes: list[CadHole], pmi: Pmi) -> set[str]:
     """Fill ``pmi.datums``; the labels kept."""
     faces_of: dict[str, list[int]] = {}
     for lab in _labels(gdt.GetDatumLabels):
@@ -198,7 +203,7 @@ def _graphical(label: TDF_Label) -> bool:
     return kind in (PRESENTATION, COMMON_LABEL)
 
 
-def _tolerance(gdt, lab, geo: _Faces, holes, datums: set[str], pmi: Pmi) -> None:  # noqa: ANN001
+def _tolerance(gdt, lab, geo: _Faces, holes, datums: set[str], pmi: Pmi) -> None:
     obj = _attr(lab, XCAFDoc_GeomTolerance).GetObject()
     name = _name(obj) or "geometric tolerance"
     kind = str(obj.GetType()).rsplit("_", 1)[-1]
@@ -234,7 +239,7 @@ def _tolerance(gdt, lab, geo: _Faces, holes, datums: set[str], pmi: Pmi) -> None
         }
 
 
-def _dimension(lab, geo: _Faces, holes, pmi: Pmi) -> None:  # noqa: ANN001
+def _dimension(lab, geo: _Faces, holes, pmi: Pmi) -> None:
     obj = _attr(lab, XCAFDoc_Dimension).GetObject()
     name = _name(obj) or "dimension"
     kind = str(obj.GetType()).split("DimensionType_", 1)[-1]
@@ -259,8 +264,7 @@ def _dimension(lab, geo: _Faces, holes, pmi: Pmi) -> None:  # noqa: ANN001
     for h in on:
         if abs(h.diameter_m - nominal_m) > SAME_SIZE_M:
             pmi.unmodelled.append(
-                f"{what} on {h.id}: another bore than the measured one "
-                f"({h.diameter_m * 1e3:g} mm)"
+                f"{what} on {h.id}: another bore than the measured one ({h.diameter_m * 1e3:g} mm)"
             )
             continue
         pmi.tolerances.setdefault(h.id, {})["size"] = {

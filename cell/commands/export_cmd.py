@@ -21,7 +21,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("format", choices=("ros2",), help="the export format")
     p.add_argument("source", metavar="tour.json|RUN_DIR", help="a tour file or a run directory")
     p.add_argument("-o", "--output", default=None, help="bag folder (default: SOURCE_bag)")
-    p.add_argument("--cell", default=None, help="the tour's cell file (adds cell -> base /tf_static)")
+    p.add_argument(
+        "--cell", default=None, help="the tour's cell file (adds cell -> base /tf_static)"
+    )
     p.add_argument("--overwrite", action="store_true", help="replace an existing bag folder")
     p.set_defaults(handler=run_export)
 

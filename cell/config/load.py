@@ -10,9 +10,9 @@ from pydantic import ValidationError
 
 from cell.config.checks import cell_problems
 from cell.config.datum_checks import gdt_problems
+from cell.config.datums import Datum
 from cell.config.holes_csv import read_holes_csv
 from cell.config.problems import pydantic_problems
-from cell.config.datums import Datum
 from cell.config.schema import (
     CellConfig,
     Hole,

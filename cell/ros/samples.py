@@ -92,7 +92,11 @@ def sample_at(q: NDArray[np.float64], dt: float, t: float) -> NDArray[np.float64
 
 
 def joint_states(
-    store: Typestore, names: list[str], q: NDArray[np.float64], dt: float, rate_hz: float,
+    store: Typestore,
+    names: list[str],
+    q: NDArray[np.float64],
+    dt: float,
+    rate_hz: float,
     start_ns: int,
 ) -> list[tuple[int, Any]]:
     """``JointState`` every 1/``rate_hz`` s over the trajectory, with their bag times (ns)."""

@@ -1,14 +1,17 @@
 """A tour as a ROS 2 bag (MCAP storage): what RViz and Foxglove replay.
 
-Topics (times from the bag's start, ``start_ns``):
+Topics (times from the bag's start, ``start_ns``; docs/ros.md):
 
-| topic | type | what |
-|---|---|---|
-| ``/joint_trajectory`` | ``trajectory_msgs/JointTrajectory`` | the whole tour, every row of ``tour.json`` (``dt``) |
-| ``/display_planned_path`` | ``moveit_msgs/DisplayTrajectory`` | the same for RViz's MoveIt trajectory display, starting at home |
-| ``/joint_states`` | ``sensor_msgs/JointState`` | the arm sampled at 100 Hz (linear between rows) |
-| ``/inspection/stops`` | ``visualization_msgs/MarkerArray`` | per stop, the view arrow and the hole id |
-| ``/tf_static`` | ``tf2_msgs/TFMessage`` | cell -> the URDF's root link (when the cell is given) |
+- ``/joint_trajectory`` (``trajectory_msgs/JointTrajectory``): the whole tour, every row of
+  ``tour.json`` at ``k dt``;
+- ``/display_planned_path`` (``moveit_msgs/DisplayTrajectory``): the same for RViz's MoveIt
+  trajectory display, starting at home;
+- ``/joint_states`` (``sensor_msgs/JointState``): the arm sampled at 100 Hz (linear between
+  rows);
+- ``/inspection/stops`` (``visualization_msgs/MarkerArray``): per stop, the view arrow and the
+  hole id;
+- ``/tf_static`` (``tf2_msgs/TFMessage``): cell -> the URDF's root link (when the cell is
+  given).
 
 Joint names are the tour's, which the planner took from the URDF.
 """

@@ -29,14 +29,12 @@ class TrueHole:
     bores_m: tuple[float, ...]
 
 
-def _unit(v) -> np.ndarray:  # noqa: ANN001
+def _unit(v) -> np.ndarray:
     v = np.asarray(v, dtype=float)
     return v / np.linalg.norm(v)
 
 
-def drill(
-    origin_mm, normal, diameter_mm: float, depth_mm: float, over_mm: float = 2.0
-) -> Part:  # noqa: ANN001
+def drill(origin_mm, normal, diameter_mm: float, depth_mm: float, over_mm: float = 2.0) -> Part:
     """A cylinder that cuts a hole of ``depth_mm`` into the material from ``origin_mm`` on the
     surface, against ``normal`` (sticking out ``over_mm`` above the surface)."""
     plane = Plane(origin=tuple(origin_mm), z_dir=tuple(_unit(normal)))
@@ -46,7 +44,7 @@ def drill(
     return Location(plane) * (Pos(0, 0, over_mm) * tool)
 
 
-def _true(entry_mm, normal, d_mm, depth_mm, through, bores_mm) -> TrueHole:  # noqa: ANN001
+def _true(entry_mm, normal, d_mm, depth_mm, through, bores_mm) -> TrueHole:
     n = _unit(normal)
     return TrueHole(
         tuple(float(v) * 1e-3 for v in entry_mm),
@@ -118,7 +116,7 @@ def angled() -> tuple[Part, list[TrueHole]]:
     # vertical through hole at x = 25: the axis crosses the face where z = 10 + x tan(a)
     x3 = 25.0
     e3 = np.array([x3, 0.0, 10.0 + x3 * math.tan(a)])
-    tools.append(drill(e3 + [0, 0, 5], (0, 0, 1), 6.0, 100.0, over_mm=10))
+    tools.append(drill(e3 + np.array([0.0, 0.0, 5.0]), (0, 0, 1), 6.0, 100.0, over_mm=10))
     holes.append(_true(e3, (0, 0, 1), 6.0, e3[2] + 30, True, (6.0,)))
     return part - tools, holes
 

@@ -31,7 +31,7 @@ def parts(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, lis
     return {name: write_part(name, folder) for name in GENERATORS}
 
 
-def _match(found, truth: list[TrueHole]) -> None:  # noqa: ANN001
+def _match(found, truth: list[TrueHole]) -> None:
     assert len(found) == len(truth)
     pos = np.array([h.entry_m for h in found])
     used = set()
@@ -50,12 +50,12 @@ def _match(found, truth: list[TrueHole]) -> None:  # noqa: ANN001
 
 
 @pytest.mark.parametrize("name", sorted(GENERATORS))
-def test_every_hole_as_the_script_cut_it(parts, name: str) -> None:  # noqa: ANN001
+def test_every_hole_as_the_script_cut_it(parts, name: str) -> None:
     path, truth = parts[name]
     _match(import_step(path, mesh=False).scan.holes, truth)
 
 
-def test_a_counterbore_is_one_hole_measured_at_its_entry_bore(parts) -> None:  # noqa: ANN001
+def test_a_counterbore_is_one_hole_measured_at_its_entry_bore(parts) -> None:
     holes = import_step(parts["plate"][0], mesh=False).scan.holes
     stepped = [h for h in holes if len(h.bores) > 1]
     assert len(stepped) == 2
@@ -64,8 +64,8 @@ def test_a_counterbore_is_one_hole_measured_at_its_entry_bore(parts) -> None:  #
         assert sum(b.length_m for b in h.bores) == pytest.approx(h.depth_m, abs=1e-9)
 
 
-def test_the_same_part_in_metres_gives_the_same_holes(parts, tmp_path: Path) -> None:  # noqa: ANN001
-    path, truth = parts["angled"]
+def test_the_same_part_in_metres_gives_the_same_holes(parts, tmp_path: Path) -> None:
+    path = parts["angled"][0]
     text = path.read_text()
     assert "SI_UNIT(.MILLI.,.METRE.)" in text
     metres = tmp_path / "angled_m.step"
@@ -92,7 +92,7 @@ def test_fillets_bosses_and_shafts_are_no_holes(tmp_path: Path) -> None:
 
 def test_a_step_that_does_not_parse_is_one_line_naming_file_and_entity(
     parts, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:  # noqa: ANN001
+) -> None:
     text = parts["plate"][0].read_text()
     head, sep, tail = text.partition("#20 = ")
     broken = tmp_path / "broken.step"
@@ -108,7 +108,7 @@ def test_a_step_that_does_not_parse_is_one_line_naming_file_and_entity(
     assert not (tmp_path / "h.csv").exists()
 
 
-def test_cli_writes_a_holes_csv_the_cell_file_reads(parts, tmp_path: Path) -> None:  # noqa: ANN001
+def test_cli_writes_a_holes_csv_the_cell_file_reads(parts, tmp_path: Path) -> None:
     path, truth = parts["weldment"]
     out = tmp_path / "holes.csv"
     stl = tmp_path / "part.stl"
@@ -129,14 +129,14 @@ def _match_rows(rows: list[dict[str, object]], truth: list[TrueHole]) -> None:
         assert np.dot(rows[k]["normal"], t.normal) == pytest.approx(1.0, abs=1e-9)
 
 
-def test_csv_round_trip_in_every_unit(parts, tmp_path: Path) -> None:  # noqa: ANN001
+def test_csv_round_trip_in_every_unit(parts, tmp_path: Path) -> None:
     part = import_step(parts["tube"][0], mesh=False)
     for unit in ("m", "mm", "um"):
         out = write_holes_csv(tmp_path / f"h_{unit}.csv", hole_rows(part), unit)
         _match_rows(read_holes_csv(out), parts["tube"][1])
 
 
-def test_part_step_in_the_cell_file_adds_holes_and_the_mesh(parts, tmp_path: Path) -> None:  # noqa: ANN001
+def test_part_step_in_the_cell_file_adds_holes_and_the_mesh(parts, tmp_path: Path) -> None:
     data = without_drawing(yaml.safe_load(builtin_cell_path().read_text()))
     data["part"]["holes"] = []
     path, truth = parts["plate"]

@@ -17,11 +17,11 @@ NIST = Path(__file__).parents[1] / "data" / "nist" / "nist_ctc_01_asme1_ap242.st
 
 
 @pytest.fixture(scope="module")
-def ctc01():  # noqa: ANN201
+def ctc01():
     return import_step(NIST, mesh=False)
 
 
-def test_ctc01_holes(ctc01) -> None:  # noqa: ANN001
+def test_ctc01_holes(ctc01) -> None:
     holes = ctc01.scan.holes
     assert len(holes) == 10
     sizes = sorted(round(h.diameter_m * 1e3, 6) for h in holes)
@@ -36,16 +36,18 @@ def _limits_in_text() -> set[tuple[float, float]]:
     """The upper/lower limits of the size dimensions as the STEP text states them (a second
     reading, by regular expression, of what OpenCascade reads)."""
     text = NIST.read_text(encoding="latin-1")
-    upper = re.findall(r"LENGTH_MEASURE\(([-\d.]+)\),#\d+\)\s*REPRESENTATION_ITEM\('upper limit'", text)
-    lower = re.findall(r"LENGTH_MEASURE\(([-\d.]+)\),#\d+\)\s*REPRESENTATION_ITEM\('lower limit'", text)
+    upper = re.findall(
+        r"LENGTH_MEASURE\(([-\d.]+)\),#\d+\)\s*REPRESENTATION_ITEM\('upper limit'", text
+    )
+    lower = re.findall(
+        r"LENGTH_MEASURE\(([-\d.]+)\),#\d+\)\s*REPRESENTATION_ITEM\('lower limit'", text
+    )
     return {(float(u), float(lo)) for u, lo in zip(upper, lower, strict=True)}
 
 
-def test_ctc01_size_tolerances_as_the_file_states_them(ctc01) -> None:  # noqa: ANN001
+def test_ctc01_size_tolerances_as_the_file_states_them(ctc01) -> None:
     by_id = {h.id: h for h in ctc01.scan.holes}
-    sizes = {
-        hid: t["size"] for hid, t in ctc01.pmi.tolerances.items() if "size" in t
-    }
+    sizes = {hid: t["size"] for hid, t in ctc01.pmi.tolerances.items() if "size" in t}
     assert len(sizes) == 7
     assert all(s["pmi_id"] == "diameter" for s in sizes.values())
     limits = {
@@ -60,7 +62,7 @@ def test_ctc01_size_tolerances_as_the_file_states_them(ctc01) -> None:  # noqa: 
     assert {(35.0, 34.8), (35.2, 35.0), (20.05, 19.9), (20.1, 19.95), (25.15, 24.85)} <= limits
 
 
-def test_ctc01_what_is_not_modelled_is_listed(ctc01) -> None:  # noqa: ANN001
+def test_ctc01_what_is_not_modelled_is_listed(ctc01) -> None:
     listed = "\n".join(ctc01.pmi.unmodelled)
     for name in ("Flatness.1", "Perpendicularity.1", "Position surfacic profile.2",
                  "Position.1", "Position.2", "datum B", "datum C"):  # fmt: skip

@@ -45,13 +45,23 @@ def _rosbags(bag: Path, topics: tuple[str, ...]) -> dict[str, list]:
 def _urdf_joints(model: str) -> list[str]:
     urdf = Path(__file__).parents[2] / "robots" / "urdf" / f"{model}.urdf"
     tree = etree.parse(str(urdf))
-    return [j.get("name") for j in tree.iter("joint") if j.get("type") in ("revolute", "continuous")]
+    return [
+        j.get("name") for j in tree.iter("joint") if j.get("type") in ("revolute", "continuous")
+    ]
 
 
 @pytest.fixture(scope="module")
 def tour_bag(small_cell: SmallCell, tmp_path_factory: pytest.TempPathFactory) -> Path:
     bag = tmp_path_factory.mktemp("bags") / "tour_bag"
-    args = ["export", "ros2", str(small_cell.tour_path), "-o", str(bag), "--cell", str(small_cell.path)]
+    args = [
+        "export",
+        "ros2",
+        str(small_cell.tour_path),
+        "-o",
+        str(bag),
+        "--cell",
+        str(small_cell.path),
+    ]
     assert main(args) == 0
     return bag
 
@@ -105,8 +115,9 @@ def test_stops_are_markers_and_the_base_is_placed(small_cell: SmallCell, tour_ba
     assert tf.header.frame_id == "cell" and tf.child_frame_id == "base_link"
 
 
-def test_an_existing_bag_is_not_overwritten(small_cell: SmallCell, tour_bag: Path,
-                                            capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+def test_an_existing_bag_is_not_overwritten(
+    small_cell: SmallCell, tour_bag: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     before = sorted(p.stat().st_mtime_ns for p in tour_bag.iterdir())
     assert main(["export", "ros2", str(small_cell.tour_path), "-o", str(tour_bag)]) == 2
     err = capsys.readouterr().err
