@@ -27,8 +27,10 @@ def test_pmi_ids_are_attributes_of_the_characteristic_items(tmp_path: Path) -> N
     validate_file(path)
     root = etree.parse(str(path)).getroot()
     found = {}
-    for item in root.iter("{%s}PositionCharacteristicItem" % NS["q"],
-                          "{%s}DiameterCharacteristicItem" % NS["q"]):  # fmt: skip
+    q = NS["q"]
+    for item in root.iter(
+        f"{{{q}}}PositionCharacteristicItem", f"{{{q}}}DiameterCharacteristicItem"
+    ):
         attr = item.find("q:Attributes/q:AttributeStr[@name='pmi_id']", NS)
         if attr is not None:
             found[item.findtext("q:Name", "", NS)] = attr.get("value")
