@@ -3,7 +3,9 @@ reported with the file name, the field path and the value."""
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import yaml
 from pydantic import ValidationError
@@ -19,6 +21,9 @@ from cell.config.schema import (
 )
 from cell.config.yaml_problem import yaml_problem
 from cell.errors import ConfigError
+
+if TYPE_CHECKING:
+    from cell.cad.part import ImportedPart
 
 DATA_DIR = Path(__file__).parents[1] / "data"
 BUILTIN_CELLS = ("motorcycle_frame",)
@@ -48,9 +53,18 @@ def _with_csv_holes(
     return out
 
 
+@functools.lru_cache(maxsize=4)
+def _imported(path: str, stamp: int, mesh: bool, deflection_m: float) -> ImportedPart:
+    """A STEP file imported, kept while it is unchanged (a cell is loaded many times)."""
+    from cell.cad.part import import_step
+
+    del stamp  # part of the key only
+    return import_step(path, mesh=mesh, deflection_m=deflection_m)
+
+
 def _with_step(cfg: CellConfig, source_path: Path | None, text: str) -> CellConfig:
     """The cell with the holes (and drawing, and mesh) of ``part.step`` (docs/cad_import.md)."""
-    from cell.cad.part import hole_rows, import_step  # OpenCascade: only for cells with a STEP
+    from cell.cad.part import hole_rows  # OpenCascade: only for cells with a STEP
     from cell.config.step_part import drawing
 
     spec = cfg.part.step
@@ -60,7 +74,7 @@ def _with_step(cfg: CellConfig, source_path: Path | None, text: str) -> CellConf
         path = cfg.base_dir / path
     if not path.is_file():
         raise ConfigError(str(path), [("part.step.path", spec.path, "no such file")])
-    part = import_step(path, mesh=spec.mesh, deflection_m=spec.deflection_m)
+    part = _imported(str(path.resolve()), path.stat().st_mtime_ns, spec.mesh, spec.deflection_m)
     rows = hole_rows(part)
     datums, tolerances, _ = drawing(part.pmi.datums, part.pmi.tolerances)
     use_pmi = spec.pmi and not cfg.part.datums
