@@ -151,3 +151,22 @@ def test_part_step_in_the_cell_file_adds_holes_and_the_mesh(parts, tmp_path: Pat
     assert mesh.mesh is not None and len(mesh.mesh.faces) > 100
     # the mesh holds the part, in metres
     assert np.ptp(mesh.mesh.vertices, axis=0) == pytest.approx([0.12, 0.08, 0.012], abs=1e-9)
+
+
+@pytest.mark.parametrize("deflection_m", [1e-3, 1e-4])
+def test_the_mesh_is_within_its_deflection(tmp_path: Path, deflection_m: float) -> None:
+    """The tessellated tube (holes and all) against OpenCascade's exact volume and area: a
+    mesh within ``deflection_m`` of the surface differs in volume by less than deflection x
+    area, and closes (watertight)."""
+    import trimesh
+    from cad_parts import tube
+
+    part, _ = tube()
+    path = tmp_path / "tube.step"
+    export_step(part, str(path))
+    mesh = import_step(path, deflection_m=deflection_m).mesh
+    tm = trimesh.Trimesh(mesh.vertices, mesh.faces)
+    tm.merge_vertices()
+    assert tm.is_watertight
+    exact_volume_m3, area_m2 = part.volume * 1e-9, part.area * 1e-6
+    assert abs(tm.volume - exact_volume_m3) <= deflection_m * area_m2
