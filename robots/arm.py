@@ -123,6 +123,7 @@ class Arm:
         self._collision: CollisionModel | None = None
         self._batch: tuple[CollisionModel, BatchCollision] | None = None
         self.clearance_margins = Clearance()
+        self.disabled_pairs: list[tuple[str, str]] = []
 
     @property
     def dh(self) -> DHTable:
@@ -144,6 +145,20 @@ class Arm:
         self.obstacles.extend(shapes)
         self._collision = None
 
+    def link_names(self) -> set[str]:
+        """The names of the URDF's links and frames."""
+        return {f.name for f in self.model.frames}
+
+    def set_disabled_pairs(self, pairs: Sequence[tuple[str, str]]) -> None:
+        """Pairs of links never checked against each other (a MoveIt SRDF's
+        ``disable_collisions``), besides the adjacent ones and those touching at q = 0; a
+        link the URDF does not have is refused."""
+        unknown = sorted({n for pair in pairs for n in pair} - self.link_names())
+        if unknown:
+            raise UrdfError(str(self.urdf_path), f"has no links {unknown}")
+        self.disabled_pairs = [(a, b) for a, b in pairs]
+        self._collision = None
+
     def set_clearance(self, robot_m: float, tool_m: float) -> None:
         """Margins (m) kept by every check: arm vs obstacles, tool vs obstacles and arm links."""
         self.clearance_margins = Clearance(robot_m, tool_m)
@@ -155,7 +170,12 @@ class Arm:
         if self._collision is None:
             in_base = [s.moved(self._T_base_cell) for s in self.obstacles]
             self._collision = CollisionModel(
-                self.model, self._robot_geoms, self.tool_shapes, in_base, self.clearance_margins
+                self.model,
+                self._robot_geoms,
+                self.tool_shapes,
+                in_base,
+                self.clearance_margins,
+                self.disabled_pairs,
             )
         return self._collision
 

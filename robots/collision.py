@@ -6,7 +6,8 @@ a body on ``link_6``), and every robot body against every obstacle. Two robot
 bodies of which any shapes already touch at q = 0 are a design overlap (the
 wrist's link_6 turns inside link_4's fork, whose enclosing shapes are solid) and
 are not checked against each other at all (reported in
-:attr:`CollisionModel.excluded_pairs`, as MoveIt's "Default" disabled pairs).
+:attr:`CollisionModel.excluded_pairs`, as MoveIt's "Default" disabled pairs); nor are the
+pairs of links a user disables (``disabled``: a MoveIt SRDF's ``disable_collisions``).
 
 Clearance (:class:`Clearance`): a pair is "in collision" when its shapes come
 closer than the pair's margin, coal's ``CollisionRequest.security_margin``
@@ -30,6 +31,7 @@ overlapping cylinder pairs as free (seen on the forearm against the upper arm).
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass
 from typing import TypeAlias
 
@@ -139,9 +141,12 @@ class CollisionModel:
         tool_shapes: list[Shape],
         obstacles: list[Shape],
         clearance: Clearance | None = None,
+        disabled: Collection[tuple[str, str]] = (),
     ) -> None:
         self.model = model
         self.clearance_margins = clearance or Clearance()
+        #: pairs of links never checked, given by the user (a MoveIt SRDF's disable_collisions)
+        self.disabled = {frozenset(p) for p in disabled}
         self.geom_model = geom_model.copy()
         tool0 = model.getFrameId("tool0")
         link6_joint = model.frames[tool0].parentJoint
@@ -172,6 +177,8 @@ class CollisionModel:
                     continue
                 both_robot = a.body != "obstacle" and b.body != "obstacle"
                 if both_robot and abs(order[a.body] - order[b.body]) <= 1:
+                    continue
+                if both_robot and frozenset((a.body, b.body)) in self.disabled:
                     continue
                 pairs.append((i, j))
         return pairs

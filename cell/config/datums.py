@@ -54,6 +54,8 @@ class PositionTolerance(_Strict):
     zone_diameter_m: float
     datums: list[str] = []
     material_condition: Literal["RFS", "MMC", "LMC"] = "RFS"
+    #: the drawing's name of this tolerance (an AP242 PMI's, ``holecell import-step``)
+    pmi_id: str | None = None
 
 
 class SizeTolerance(_Strict):
@@ -61,6 +63,8 @@ class SizeTolerance(_Strict):
 
     upper_m: float
     lower_m: float
+    #: the drawing's name of this tolerance (an AP242 PMI's, ``holecell import-step``)
+    pmi_id: str | None = None
 
 
 class Tolerances(_Strict):
@@ -87,6 +91,8 @@ class Datum(_Strict):
     hole: str | None = None
     pattern: list[str] | None = None
     rps: list[RpsPoint] | None = None
+    #: the drawing's name of this datum (an AP242 PMI's, ``holecell import-step``)
+    pmi_id: str | None = None
 
     def model_post_init(self, __context: Any) -> None:
         kinds = [k for k in DATUM_KINDS if getattr(self, k) is not None]

@@ -119,3 +119,35 @@ def read_holes_csv(path: str | Path) -> list[dict[str, object]]:
             }
         )
     return holes
+
+
+def write_holes_csv(path: str | Path, holes: list[dict[str, object]], unit: str = "mm") -> Path:
+    """Write holes (mappings with ``id``, ``position``, ``normal``, ``diameter`` in m, and
+    optionally ``tolerance`` (m) and ``extra``: more columns, ignored by :func:`read_holes_csv`)
+    as a holes CSV with lengths in ``unit`` (``m``, ``mm`` or ``um``); returns the path."""
+    if unit not in LENGTH_UNITS:
+        raise ConfigError(str(path), [("--units", unit, "write m, mm or um")])
+    f = 1.0 / LENGTH_UNITS[unit]
+    extra_cols: list[str] = []
+    for h in holes:
+        for k in dict(h.get("extra") or {}):  # type: ignore[call-overload]
+            if k not in extra_cols:
+                extra_cols.append(k)
+    header = ["id", f"x_{unit}", f"y_{unit}", f"z_{unit}", "nx", "ny", "nz", f"diameter_{unit}"]
+    header += [f"tolerance_{unit}", *extra_cols]
+    p = Path(path)
+    with p.open("w", newline="", encoding="utf-8") as fh:
+        out = csv.writer(fh)
+        out.writerow(header)
+        for h in holes:
+            pos = [float(v) * f for v in h["position"]]  # type: ignore[attr-defined]
+            tol = h.get("tolerance")
+            extra = dict(h.get("extra") or {})  # type: ignore[call-overload]
+            out.writerow(
+                [h["id"], *(f"{v:.9g}" for v in pos)]
+                + [f"{float(v):.12g}" for v in h["normal"]]  # type: ignore[attr-defined]
+                + [f"{float(h['diameter']) * f:.9g}"]  # type: ignore[arg-type]
+                + ["" if tol is None else f"{float(tol) * f:.9g}"]  # type: ignore[arg-type]
+                + [extra.get(k, "") for k in extra_cols]
+            )
+    return p

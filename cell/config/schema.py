@@ -20,7 +20,10 @@ from cell.config.datums import Alignment, Datum, Tolerances
 from cell.config.markers import ReferenceMarker, ScaleBar
 from cell.config.pose import IDENTITY, Pose, Positive, Vec3, _Strict, unit_normal
 from cell.config.shapes import ShapeSpec
+from cell.config.srdf import Srdf, read_srdf
+from cell.config.step_part import StepSpec
 from cell.config.target import CalibrationTargetBoard
+from cell.errors import ConfigError
 from cell.uncertainty.materials import (
     BUILTIN_MATERIALS,
     DEFAULT_MATERIAL,
@@ -29,6 +32,7 @@ from cell.uncertainty.materials import (
     material_field,
 )
 from robots import DEFAULT_MODEL, Arm, LimitScaling, Shape
+from robots.meshes import TriangleMesh
 
 JointRange = Annotated[list[float], Field(min_length=2, max_length=2)]
 
@@ -44,8 +48,15 @@ class Limits(_Strict):
 class Robot(_Strict):
     model: str = DEFAULT_MODEL
     base: Pose = IDENTITY
-    home: Annotated[list[float], Field(min_length=6, max_length=6)]
+    #: six joint values (rad), or the name of a ``group_state`` of ``srdf``
+    home: (
+        Annotated[list[float], Field(min_length=6, max_length=6)]
+        | Annotated[str, Field(min_length=1)]
+    )
     limits: Limits = Limits()
+    #: a MoveIt SRDF (relative to the cell file): disabled collision pairs, named states
+    #: (:mod:`cell.config.srdf`)
+    srdf: str | None = None
     #: folders (relative to the cell file) searched first for package:// mesh URIs
     package_paths: list[str] = []
     #: ISO 9283 pose repeatability RP (m); None: the maker's figure for the model
@@ -84,6 +95,8 @@ class Part(_Strict):
     holes: list[Hole] = []
     #: more holes from a CSV, relative to the cell file (:mod:`cell.config.holes_csv`)
     holes_csv: str | None = None
+    #: holes, drawing and mesh from the part's STEP file (:mod:`cell.config.step_part`)
+    step: StepSpec | None = None
     obstacles: list[ShapeSpec] = []
     #: a built-in name or {name, alpha_per_K, u_alpha_per_K}; None: steel assumed
     material: MaterialSpec | None = None
@@ -99,6 +112,9 @@ class Part(_Strict):
     alignment: Alignment | None = None
 
     _material = field_validator("material", mode="before")(lambda cls, v: material_field(v))
+    _step = field_validator("step", mode="before")(
+        lambda cls, v: {"path": v} if isinstance(v, str) else v
+    )
 
 
 class Environment(_Strict):
@@ -151,6 +167,8 @@ class CellConfig(_Strict):
 
     _source_path: Path | None = PrivateAttr(default=None)
     _raw_text: str = PrivateAttr(default="")
+    #: the part's mesh tessellated from ``part.step`` (m, part frame), when asked for
+    _step_mesh: TriangleMesh | None = PrivateAttr(default=None)
 
     @property
     def source_path(self) -> Path | None:
@@ -175,8 +193,29 @@ class CellConfig(_Strict):
         return self.tool.tool0_to_tcp.matrix()
 
     def home_q(self) -> np.ndarray:
-        """The home joint vector (rad)."""
-        return np.array(self.robot.home, dtype=float)
+        """The home joint vector (rad): ``robot.home``, or the SRDF's state it names."""
+        home = self.robot.home
+        if isinstance(home, str):
+            srdf = self.srdf()
+            if srdf is None:
+                raise ConfigError(
+                    str(self._source_path or "<cell>"),
+                    [
+                        (
+                            "robot.home",
+                            home,
+                            "a state name needs robot.srdf (else give 6 values, rad)",
+                        )
+                    ],
+                )
+            return np.array(srdf.state(home, list(self.build_robot().joint_names)), dtype=float)
+        return np.array(home, dtype=float)
+
+    def srdf(self) -> Srdf | None:
+        """``robot.srdf`` read, or None."""
+        if self.robot.srdf is None:
+            return None
+        return read_srdf(self._relative_to_cell(self.robot.srdf))
 
     def holes_in_cell(self) -> list[HoleInCell]:
         """Every hole with its centre and normal in the cell frame."""
@@ -206,6 +245,8 @@ class CellConfig(_Strict):
         """Part and environment obstacles and the calibration plate, poses in the cell frame."""
         T_part, d = self.T_cell_part(), self.base_dir
         part = [s.to_shape(T_part, f"part{i}", d) for i, s in enumerate(self.part.obstacles)]
+        if self._step_mesh is not None:
+            part.append(Shape("mesh", (), T_part, "part_step", self._step_mesh))
         env = [
             s.to_shape(np.eye(4), f"env{i}", d) for i, s in enumerate(self.environment.obstacles)
         ]
@@ -230,16 +271,33 @@ class CellConfig(_Strict):
         return [self._relative_to_cell(p) for p in self.robot.package_paths]
 
     def build_robot(self) -> Arm:
-        """The bare arm: model, base pose, limits and their scaling (no tool, no obstacles)."""
+        """The bare arm: model, base pose, limits and their scaling, the SRDF's disabled
+        collision pairs (no tool, no obstacles)."""
         lim = self.robot.limits
         scaling = LimitScaling(lim.velocity_scale, lim.acceleration_scale, lim.jerk_scale)
-        return Arm(
+        arm = Arm(
             self.robot_model(),
             T_cell_base=self.T_cell_base(),
             scaling=scaling,
             package_paths=self.package_paths(),
             position_limits=lim.position,
         )
+        srdf = self.srdf()
+        if srdf is not None and srdf.disabled:
+            unknown = sorted({n for a, b, _ in srdf.disabled for n in (a, b)} - arm.link_names())
+            if unknown:
+                raise ConfigError(
+                    srdf.path,
+                    [
+                        (
+                            "disable_collisions",
+                            unknown,
+                            f"links not in the URDF {arm.urdf_path.name}",
+                        )
+                    ],
+                )
+            arm.set_disabled_pairs([(a, b) for a, b, _ in srdf.disabled])
+        return arm
 
     def build_arm(self) -> Arm:
         """The arm with its base pose, limit scaling, tool and every obstacle attached."""

@@ -235,7 +235,8 @@ class _Run:
     def _position(self, h: Hole, pos: dict, size: dict | None, drf_id: str) -> dict[str, Any]:
         rec = {"id": f"{h.id}.position", "hole_id": h.id, "kind": "position", "drf": drf_id,
                "datums": list(pos["datums"]), "material_condition": pos["material_condition"],
-               "zone_diameter_m": pos["zone_diameter_m"], "bonus_m": 0.0}  # fmt: skip
+               "zone_diameter_m": pos["zone_diameter_m"], "bonus_m": 0.0,
+               **_drawing_name(pos)}  # fmt: skip
         r = self.results.get(h.id)
         why = _not_measured(self.cell, self.results, [h.id])
         if not why and drf_id != FIXTURE and drf_id not in self.frames:
@@ -315,6 +316,7 @@ class _Run:
             "nominal_m": h.diameter,
             "upper_m": size["upper_m"],
             "lower_m": size["lower_m"],
+            **_drawing_name(size),
         }
         r = self.results.get(h.id)
         why = _not_measured(self.cell, self.results, [h.id])
@@ -331,6 +333,11 @@ def _blank(kind: str) -> dict[str, Any]:
     base = {"actual_m": None, "deviation_m": None, "value_m": None, "U_m": None,
             "decision": NOT_EVALUATED}  # fmt: skip
     return {**base, "nominal_m": None} if kind == "position" else base
+
+
+def _drawing_name(spec: dict) -> dict[str, str]:
+    """``{"pmi_id": ...}`` when the tolerance carries the drawing's name (AP242 PMI), else {}."""
+    return {"pmi_id": spec["pmi_id"]} if spec.get("pmi_id") else {}
 
 
 def _specs(h: Hole) -> tuple[dict | None, dict | None]:

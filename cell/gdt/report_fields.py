@@ -21,8 +21,8 @@ import yaml
 from pydantic import ValidationError
 
 from cell.config import CellConfig
-from cell.config.load import _with_csv_holes
-from cell.errors import ConfigError
+from cell.config.load import _with_csv_holes, _with_step
+from cell.errors import CellError, ConfigError
 from cell.gdt.decide import CONFORMANCE, INDETERMINATE, NONCONFORMANCE, NOT_EVALUATED, hole_decision
 from cell.gdt.evaluate import FIXTURE, Evaluation, evaluate
 from cell.records.hole_result import HoleResult
@@ -41,6 +41,10 @@ def run_cell(info: dict[str, Any]) -> CellConfig:
         # a CSV that is gone: its holes get no characteristics, the rest are kept
         with contextlib.suppress(ConfigError, OSError):
             cfg = _with_csv_holes(cfg, str(path), path, info["cell_text"])
+    if cfg.part.step is not None:
+        # likewise a STEP file that is gone (CellError: it no longer parses)
+        with contextlib.suppress(CellError, OSError):
+            cfg = _with_step(cfg, path, info["cell_text"])
     return cfg
 
 

@@ -92,6 +92,8 @@ def characteristic_section(
         if k == "Diameter":
             sub(n, "TargetValue", dec(c["nominal_m"]))
         it = sub(items, f"{k}CharacteristicItem", id=str(i_id))
+        if c.get("pmi_id"):  # the drawing's name of the characteristic (AP242 PMI)
+            sub(counted(it, "Attributes"), "AttributeStr", name="pmi_id", value=str(c["pmi_id"]))
         sub(it, "Name", name)
         ids_list(it, "FeatureItemIds", [features[c["hole_id"]].item])
         sub(it, "CharacteristicNominalId", str(n_id))

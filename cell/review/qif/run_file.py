@@ -29,7 +29,7 @@ def hole_nominals(info: Mapping[str, Any], where: str) -> dict[str, HoleNominal]
     except yaml.YAMLError as exc:
         first = str(exc).splitlines()[0]
         raise ConfigError(where, [("(yaml)", None, f"the run's cell file: {first}")]) from None
-    if cfg.part.holes_csv is not None:
+    if cfg.part.holes_csv is not None or cfg.part.step is not None:
         path = Path(info["cell_path"]) if info.get("cell_path") else None
         cfg = parse_cell(info["cell_text"], where, path)
     return {h.id: HoleNominal(h.position, h.normal, h.diameter) for h in cfg.part.holes}

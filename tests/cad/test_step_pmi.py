@@ -1,0 +1,94 @@
+"""AP242 semantic PMI (cell/cad/pmi.py) on NIST's CTC-01 test case (public domain,
+tests/data/nist/NOTICE.md) and "no semantic PMI" on a generated part."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from cad_parts import write_part
+
+from cell.cad.part import import_step
+from cell.cli import main
+from cell.config.step_part import drawing
+
+NIST = Path(__file__).parents[1] / "data" / "nist" / "nist_ctc_01_asme1_ap242.stp"
+
+
+@pytest.fixture(scope="module")
+def ctc01():
+    return import_step(NIST, mesh=False)
+
+
+def test_ctc01_holes(ctc01) -> None:
+    holes = ctc01.scan.holes
+    assert len(holes) == 10
+    sizes = sorted(round(h.diameter_m * 1e3, 6) for h in holes)
+    assert sizes == [20, 20, 25, 25, 25, 25, 35, 35, 35, 35]
+    blind = [h for h in holes if not h.through]
+    # the two side holes end in a drill point: 45 mm of wall, the cone not counted
+    assert [round(h.depth_m * 1e3, 6) for h in blind] == [45, 45]
+    assert all(h.countersunk for h in blind)
+
+
+def _limits_in_text() -> set[tuple[float, float]]:
+    """The upper/lower limits of the size dimensions as the STEP text states them (a second
+    reading, by regular expression, of what OpenCascade reads)."""
+    text = NIST.read_text(encoding="latin-1")
+    upper = re.findall(
+        r"LENGTH_MEASURE\(([-\d.]+)\),#\d+\)\s*REPRESENTATION_ITEM\('upper limit'", text
+    )
+    lower = re.findall(
+        r"LENGTH_MEASURE\(([-\d.]+)\),#\d+\)\s*REPRESENTATION_ITEM\('lower limit'", text
+    )
+    return {(float(u), float(lo)) for u, lo in zip(upper, lower, strict=True)}
+
+
+def test_ctc01_size_tolerances_as_the_file_states_them(ctc01) -> None:
+    by_id = {h.id: h for h in ctc01.scan.holes}
+    sizes = {hid: t["size"] for hid, t in ctc01.pmi.tolerances.items() if "size" in t}
+    assert len(sizes) == 7
+    assert all(s["pmi_id"] == "diameter" for s in sizes.values())
+    limits = {
+        (
+            round((by_id[h].diameter_m + s["upper_m"]) * 1e3, 6),
+            round((by_id[h].diameter_m + s["lower_m"]) * 1e3, 6),
+        )
+        for h, s in sizes.items()
+    }
+    assert _limits_in_text() <= limits  # the 35.2/34.8 range dimensions
+    # the plus/minus ones: 35 -0.2/0, 35 +0.2/0, 20 +0.05/-0.1, 20 +0.1/-0.05, 25 +-0.15
+    assert {(35.0, 34.8), (35.2, 35.0), (20.05, 19.9), (20.1, 19.95), (25.15, 24.85)} <= limits
+
+
+def test_ctc01_what_is_not_modelled_is_listed(ctc01) -> None:
+    listed = "\n".join(ctc01.pmi.unmodelled)
+    for name in ("Flatness.1", "Perpendicularity.1", "Position surfacic profile.2",
+                 "Position.1", "Position.2", "datum B", "datum C"):  # fmt: skip
+        assert name in listed
+    datums, tolerances, left = drawing(ctc01.pmi.datums, ctc01.pmi.tolerances)
+    # datum A alone (a plane through hole rims) makes no frame: said, and not kept
+    assert datums == [] and any("datums A" in line for line in left)
+    assert len(tolerances) == 7
+
+
+def test_no_semantic_pmi_is_said(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path, _ = write_part("plate", tmp_path)
+    assert not import_step(path, mesh=False).pmi.semantic
+    assert main(["import-step", str(path), "-o", str(tmp_path / "h.csv")]) == 0
+    assert "no semantic PMI" in capsys.readouterr().out
+
+
+def test_ctc01_part_yaml_carries_the_tolerances(tmp_path: Path) -> None:
+    import yaml
+
+    out = tmp_path / "part.yaml"
+    assert main(["import-step", str(NIST), "-o", str(tmp_path / "h.csv"), "--yaml", str(out)]) == 0
+    part = yaml.safe_load(out.read_text())["part"]
+    toleranced = [h for h in part["holes"] if "tolerances" in h]
+    assert len(toleranced) == 7
+    assert {h["tolerances"]["size"]["pmi_id"] for h in toleranced} == {"diameter"}
+    from cell.config.schema import Hole
+
+    assert all(Hole.model_validate(h).tolerances is not None for h in toleranced)
