@@ -116,6 +116,10 @@ class SimCamera:
         if kind == "target":
             return self._target_pair(T_cell_left, seed)
         markers = self._marker_patches(T_left_cell)
+        if feature is not None and float(T_left_cell[:3, :3] @ feature.normal
+                                         @ (T_left_cell[:3, :3] @ feature.position_m
+                                            + T_left_cell[:3, 3])) >= 0.0:  # fmt: skip
+            feature = None  # seen edge-on or from behind by the left camera: not a hole view
         if feature is None:  # bare surface facing the head, no hole anywhere near the view
             self.last_truth = CaptureTruth(None, "none", T_cell_left, None, None)
             if markers:
@@ -182,7 +186,8 @@ class SimCamera:
         for kind, f in candidates:
             p = T_head_cell[:3, :3] @ f.position_m + T_head_cell[:3, 3]
             lateral = float(np.hypot(p[0], p[1]))
-            if p[2] > 0 and lateral < best[0]:
+            facing = float((T_head_cell[:3, :3] @ f.normal) @ p) < 0.0  # its face toward us
+            if p[2] > 0 and facing and lateral < best[0]:
                 best = (lateral, kind, f)
         _, kind, feature = best
         if feature is not None and kind == "hole" and feature.id in self.missing:
