@@ -52,6 +52,7 @@ class GigeStereo:
         self.checker = PairChecker(self.options.pair_bound_ns, shared)
         self.captures = 0
         self.retries = 0
+        self._trigger_s = 0.0
         self.left.start()
         self.right.start()
 
@@ -68,8 +69,15 @@ class GigeStereo:
             if attempt + 1 < ATTEMPTS:
                 self.retries += 1
                 log.warning("%s: capture %d: %s; retrying", self.url, self.captures, why)
+                self._wait_before_retry()
         raise PairError(self.url, f"capture {self.captures}: {reasons[0]}; retried: "
                                   f"{reasons[-1]}")  # fmt: skip
+
+    def _wait_before_retry(self) -> None:
+        """Trigger the retry at least twice the pair bound after the failed trigger, so that
+        a late frame of the failed attempt cannot pass the timestamp check as the retry's."""
+        due = self._trigger_s + 2 * self.options.pair_bound_ns / 1e9
+        time.sleep(max(0.0, due - time.monotonic()))
 
     def _attempt(self) -> tuple[StereoPair | None, str]:
         for dev in (self.left, self.right):
@@ -77,6 +85,7 @@ class GigeStereo:
                 log.info("%s: discarded frame %d received before the trigger", dev.source,
                          info.frame_id)  # fmt: skip
         trigger_ns = time.time_ns() // 1000 * 1000  # the streams stamp in whole us
+        self._trigger_s = time.monotonic()
         self._trigger()
         deadline = time.monotonic() + self.options.timeout_ms / 1e3
         frames: list[Frame] = []

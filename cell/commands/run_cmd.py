@@ -15,7 +15,8 @@ from cell.calibration.use import (
     store_calibration,
     stored_calibration_path,
 )
-from cell.camera import NetworkCamera, cell_stereo
+from cell.camera import cell_stereo
+from cell.camera.open import open_camera
 from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
@@ -63,7 +64,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("tour", nargs="?", help="tour.json (not with --resume)")
     p.add_argument("--cell", help="cell file the tour was planned for")
     p.add_argument("--port", required=True, help="controller port URL")
-    p.add_argument("--camera", required=True, help="stereo head: tcp://HOST:PORT")
+    p.add_argument("--camera", required=True, help="stereo head: tcp://HOST:PORT (the simulator) or "
+                   "gige://IP_LEFT,IP_RIGHT[?trigger=...] (GigE Vision, docs/real_cell.md)")
     p.add_argument("--out", default=None, help="run directory to create (default: runs/<tour>)")
     p.add_argument("--resume", metavar="RUN_DIR", help="continue the run stored in RUN_DIR")
     p.add_argument("--thermal", help="thermal.json model to start from (holecell thermal)")
@@ -244,7 +246,7 @@ def run_run(args: argparse.Namespace) -> int:
         _clear_fault(client, args)
         if model is not None:
             check_model_sensors(model, len(client.status().temperatures_c), args.thermal)
-        camera = NetworkCamera(args.camera, cell_stereo(cell))
+        camera = open_camera(args.camera, cell_stereo(cell))
         files = open_files()
         run_dir = files.store.path.parent
         if calibration is not None:

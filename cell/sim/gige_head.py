@@ -28,8 +28,12 @@ from cell.camera.aravis import FILL_PATTERN, aravis, clib, gpointer
 
 log = logging.getLogger(__name__)
 
-#: registers of Aravis's fake camera (arvfakecamera.h)
+#: registers of Aravis's fake camera (arvfakecamera.h) and GigE Vision's heartbeat timeout
 REG_SENSOR_WIDTH, REG_SENSOR_HEIGHT, REG_WIDTH, REG_HEIGHT = 0x11C, 0x118, 0x100, 0x104
+REG_HEARTBEAT_TIMEOUT = 0x938
+#: a fake camera answers no GVCP while it renders a pair in its fill callback: it keeps its
+#: client this long without a heartbeat (ms; GigE Vision's default is 3000)
+HEARTBEAT_TIMEOUT_MS = 60_000
 #: how often a fake camera looks for a software trigger (Hz); Aravis's default is 25
 TRIGGER_POLL_HZ = 200.0
 #: pairs kept for a camera that has not filled its side yet (one camera grabbed alone)
@@ -106,7 +110,7 @@ class _FakeCamera:
         self._ptr = gpointer(self.fake)
         h, w = shape
         for reg, value in ((REG_SENSOR_WIDTH, w), (REG_SENSOR_HEIGHT, h), (REG_WIDTH, w),
-                           (REG_HEIGHT, h)):  # fmt: skip
+                           (REG_HEIGHT, h), (REG_HEARTBEAT_TIMEOUT, HEARTBEAT_TIMEOUT_MS)):  # fmt: skip
             lib.arv_fake_camera_write_register(self._ptr, reg, value)
         self.fake.set_trigger_frequency(TRIGGER_POLL_HZ)
         self.served = 0
@@ -173,7 +177,11 @@ class GigeHead:
     @classmethod
     def for_camera(cls, camera: Any, ips: tuple[str, str] = ("127.0.0.1", "127.0.0.2"),
                    faults: GigeFaults | None = None) -> GigeHead:  # fmt: skip
-        """Serve a :class:`cell.sim.camera.SimCamera` (its controller gives the stop)."""
+        """Serve a :class:`cell.sim.camera.SimCamera` (its controller gives the stop). One
+        pair is rendered first and not counted: the first render compiles and caches, and a
+        fake camera answers nothing while it renders."""
+        camera.capture()
+        camera.captures -= 1
         w, h = camera.true_stereo.image_size
         ctrl = camera.controller
 
