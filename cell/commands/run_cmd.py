@@ -17,6 +17,7 @@ from cell.calibration.use import (
 )
 from cell.camera import cell_stereo
 from cell.camera.open import open_camera
+from cell.commands.controller_cmd import add_rws_arguments, watched_client
 from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
@@ -123,6 +124,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--yes", action="store_true", help="start (and --reset) without asking")
     p.add_argument("--quiet", action="store_true", help="no progress display")
+    add_rws_arguments(p, prefix="rws-")  # --rws: watch the controller's state (RWS 1.0)
     p.set_defaults(handler=run_run)
 
 
@@ -234,7 +236,7 @@ def _ask_start() -> None:
 def run_run(args: argparse.Namespace) -> int:
     """Handler of ``holecell run``."""
     cell, model, calibration, open_files = _prepare(args)
-    client = ControllerClient(args.port)
+    client = watched_client(ControllerClient(args.port), args)
     camera = recorder = files = None
     try:
         client.connect()
