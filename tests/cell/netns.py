@@ -60,6 +60,8 @@ def in_netns(test: Callable[..., Any]) -> Callable[..., Any]:
             assert in_private_netns(), "a fake camera outside a private network namespace"
             return test(*args, **kwargs)
         if (why := _problem()) is not None:
+            if os.environ.get("CI"):  # CI runs as root with make's packages: it must run
+                pytest.fail(f"GigE test cannot run: {why}")
             pytest.skip(why)
         node = os.environ["PYTEST_CURRENT_TEST"].rsplit(" ", 1)[0]
         root = Path(__file__).resolve().parents[2]
