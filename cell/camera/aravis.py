@@ -74,6 +74,8 @@ def clib() -> ctypes.CDLL:
     lib.arv_fake_camera_set_fill_pattern.argtypes = [vp, FILL_PATTERN, vp]
     lib.arv_fake_camera_write_register.restype = ctypes.c_int
     lib.arv_fake_camera_write_register.argtypes = [vp, u32, u32]
+    lib.arv_fake_camera_read_register.restype = ctypes.c_int
+    lib.arv_fake_camera_read_register.argtypes = [vp, u32, ctypes.POINTER(u32)]
     return lib
 
 

@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import argparse
 import os
+from collections.abc import Callable
 from typing import Any
 
 from cell.commands.argtypes import positive_float
 from cell.config import load_cell
 from cell.controller.deploy import deploy
+from cell.errors import CellError
 from cell.controller.rws1 import Rws1Manager
 from cell.link.client import ControllerClient
 from cell.rapid.module import link_module, link_settings
@@ -29,6 +31,25 @@ def add_rws_arguments(p: argparse.ArgumentParser, prefix: str = "") -> None:
     p.add_argument(f"--{prefix}password", dest="rws_password", default=None,
                    help=f"RWS password (better: the environment variable {PASSWORD_ENV}; "
                         "default: the factory password); never logged or stored")  # fmt: skip
+
+
+def add_rws_trigger_argument(p: argparse.ArgumentParser) -> None:
+    """``--rws-trigger SIGNAL`` of ``holecell run``."""
+    p.add_argument("--rws-trigger", metavar="SIGNAL", default=None,
+                   help="with --rws and a gige camera with trigger=line0..3: pulse this "
+                        "controller digital output (NAME or NETWORK/UNIT/NAME), wired to both "
+                        "cameras' trigger input, for each capture")  # fmt: skip
+
+
+def trigger_pulse(client: Any, args: argparse.Namespace) -> Callable[[], None] | None:
+    """The hardware trigger of ``--rws-trigger`` (a digital output pulsed over RWS), or None."""
+    signal = getattr(args, "rws_trigger", None)
+    if signal is None:
+        return None
+    if not getattr(args, "rws", None):
+        raise CellError("--rws-trigger needs --rws")
+    manager = client.watch.manager
+    return lambda: manager.pulse(signal)
 
 
 def rws_manager(args: argparse.Namespace) -> Rws1Manager:
@@ -90,8 +111,6 @@ def _answers(port: str) -> str:
 
 def run_deploy(args: argparse.Namespace) -> int:
     """Handler of ``holecell controller deploy``."""
-    from cell.errors import CellError
-
     if not args.rws:
         raise CellError("give --rws http://HOST[:PORT]")
     cell = load_cell(args.cell)

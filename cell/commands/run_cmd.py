@@ -17,7 +17,12 @@ from cell.calibration.use import (
 )
 from cell.camera import cell_stereo
 from cell.camera.open import open_camera
-from cell.commands.controller_cmd import add_rws_arguments, watched_client
+from cell.commands.controller_cmd import (
+    add_rws_arguments,
+    add_rws_trigger_argument,
+    trigger_pulse,
+    watched_client,
+)
 from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
@@ -125,6 +130,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--yes", action="store_true", help="start (and --reset) without asking")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     add_rws_arguments(p, prefix="rws-")  # --rws: watch the controller's state (RWS 1.0)
+    add_rws_trigger_argument(p)
     p.set_defaults(handler=run_run)
 
 
@@ -248,7 +254,7 @@ def run_run(args: argparse.Namespace) -> int:
         _clear_fault(client, args)
         if model is not None:
             check_model_sensors(model, len(client.status().temperatures_c), args.thermal)
-        camera = open_camera(args.camera, cell_stereo(cell))
+        camera = open_camera(args.camera, cell_stereo(cell), trigger_pulse(client, args))
         files = open_files()
         run_dir = files.store.path.parent
         if calibration is not None:

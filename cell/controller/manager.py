@@ -60,6 +60,11 @@ class ControllerManager(Protocol):
         """The controller's state now."""
         ...
 
+    def pulse(self, signal: str) -> None:
+        """Set the digital output ``signal`` (``NAME`` or ``NETWORK/UNIT/NAME``) to 1, then
+        0: e.g. the cameras' trigger line."""
+        ...
+
     def close(self) -> None:
         """End the session."""
         ...

@@ -86,6 +86,18 @@ class Rws1Manager:
         mode = self._call("operating mode", self._rws.get_operation_mode)
         return ControllerState(str(ctrl), str(exe.ctrlexecstate), str(mode))
 
+    def pulse(self, signal: str) -> None:
+        """``POST rw/iosystem/signals/NETWORK/UNIT/NAME?action=set`` with 1, then 0 (network
+        and unit default to ``Local/DRV_1``)."""
+        parts = signal.split("/")
+        if len(parts) not in (1, 3) or not all(parts):
+            raise ControllerError(self.url, "pulse", f"signal {signal!r}: NAME or "
+                                                     "NETWORK/UNIT/NAME")  # fmt: skip
+        network, unit, name = parts if len(parts) == 3 else ("Local", "DRV_1", parts[0])
+        for value in (1, 0):
+            self._call(f"set {signal}={value}", self._rws.set_digital_io, name, value, network,
+                       unit)  # fmt: skip
+
     def close(self) -> None:
         """Log out."""
         self._rws.close()

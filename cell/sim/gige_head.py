@@ -17,6 +17,7 @@ from __future__ import annotations
 import ctypes
 import logging
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -31,6 +32,7 @@ log = logging.getLogger(__name__)
 #: registers of Aravis's fake camera (arvfakecamera.h) and GigE Vision's heartbeat timeout
 REG_SENSOR_WIDTH, REG_SENSOR_HEIGHT, REG_WIDTH, REG_HEIGHT = 0x11C, 0x118, 0x100, 0x104
 REG_HEARTBEAT_TIMEOUT = 0x938
+REG_TRIGGER_SOURCE, REG_TRIGGER_SOFTWARE = 0x304, 0x30C  # source 0: Line0, 1: Software
 #: a fake camera answers no GVCP while it renders a pair in its fill callback: it keeps its
 #: client this long without a heartbeat (ms; GigE Vision's default is 3000)
 HEARTBEAT_TIMEOUT_MS = 60_000
@@ -140,6 +142,27 @@ class _FakeCamera:
         self.gv.set_property("gvsp-lost-ratio", lost)
         self.served += 1
 
+    def line_pulse(self) -> bool:
+        """A rising edge on Line0: fire once if the client set ``TriggerSource=Line0`` (the
+        fake fires only on its software trigger register, so the edge is that register, the
+        source switched for the one frame); False: the camera does not listen to the line."""
+        lib, value = clib(), ctypes.c_uint32()
+        lib.arv_fake_camera_read_register(self._ptr, REG_TRIGGER_SOURCE, ctypes.byref(value))
+        if value.value != 0:
+            return False
+        lib.arv_fake_camera_write_register(self._ptr, REG_TRIGGER_SOURCE, 1)
+        lib.arv_fake_camera_write_register(self._ptr, REG_TRIGGER_SOFTWARE, 1)
+        return True
+
+    def line_released(self) -> bool:
+        """After :meth:`line_pulse`: the fake took the edge; the source goes back to Line0."""
+        lib, value = clib(), ctypes.c_uint32()
+        lib.arv_fake_camera_read_register(self._ptr, REG_TRIGGER_SOFTWARE, ctypes.byref(value))
+        if value.value != 0:
+            return False
+        lib.arv_fake_camera_write_register(self._ptr, REG_TRIGGER_SOURCE, 0)
+        return True
+
     def close(self) -> None:
         """Stop serving (the fake's thread ends when the object is freed)."""
         if self.gv is not None:
@@ -189,6 +212,15 @@ class GigeHead:
             return int(ctrl.s.at_stop)
 
         return cls(camera.capture, (h, w), ips, faults, stop_of)
+
+    def pulse(self, timeout_s: float = 10.0) -> None:
+        """The hardware trigger line wired to both cameras' Line0: one rising edge. Returns
+        once both cameras took it (or after ``timeout_s``)."""
+        fired = [cam for cam in self.cameras if cam.line_pulse()]
+        t_end = time.monotonic() + timeout_s
+        while fired and time.monotonic() < t_end:
+            fired = [cam for cam in fired if not cam.line_released()]
+            time.sleep(0.0005)
 
     def close(self) -> None:
         """Stop both cameras (release the clients' ``ArvCamera``s first: a fake waits up to

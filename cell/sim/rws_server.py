@@ -6,7 +6,8 @@ It keeps the calls in ``calls`` (method, path, action) and the controller's stat
 refuses what a controller refuses: a module loaded that was never uploaded, loadmod or resetpp
 without mastership, a start with the motors off or before a program pointer is set.
 ``on_start(module_path, text)`` is called when RAPID starts (e.g. to run the uploaded module
-in the interpreter); ``on_stop()`` when it stops.
+in the interpreter); ``on_stop()`` when it stops; ``on_signal(NETWORK/UNIT/NAME, value)``
+when a digital output is set (e.g. the simulated cameras' trigger line).
 """
 
 from __future__ import annotations
@@ -40,9 +41,11 @@ class RwsFake:
 
     def __init__(self, user: str = "Default User", password: str = "robotics",
                  on_start: Callable[[str, str], None] | None = None,
-                 on_stop: Callable[[], None] | None = None) -> None:  # fmt: skip
+                 on_stop: Callable[[], None] | None = None,
+                 on_signal: Callable[[str, int], None] | None = None) -> None:  # fmt: skip
         self.user, self._password = user, password
-        self.on_start, self.on_stop = on_start, on_stop
+        self.on_start, self.on_stop, self.on_signal = on_start, on_stop, on_signal
+        self.signals: dict[str, int] = {}
         self.calls: list[tuple[str, str, str]] = []
         self.refused: list[str] = []
         self.unauthorized = 0
@@ -156,6 +159,13 @@ class RwsFake:
         if path == "/rw/rapid/execution":
             return self._execution(action)
         if path.startswith("/rw/rapid/tasks/") and action in ("activate", "deactivate"):
+            return 204, None
+        if path.startswith("/rw/iosystem/signals/") and action == "set":
+            name = path[len("/rw/iosystem/signals/") :]
+            value = int(form.get("lvalue", "0"))
+            self.signals[name] = value
+            if self.on_signal is not None:
+                self.on_signal(name, value)
             return 204, None
         if path == "/rw/panel/ctrlstate" and action == "setctrlstate":
             self.ctrlstate = form.get("ctrl-state", self.ctrlstate)

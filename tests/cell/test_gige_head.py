@@ -5,8 +5,10 @@ pairs are retried once and then fail exactly that capture with the reason."""
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -66,12 +68,14 @@ def test_pairs_arrive_byte_for_byte_over_gvsp() -> None:
 
 
 @in_netns
-def test_aravis_own_tool_grabs_from_the_simulated_head(small_cell) -> None:
-    from cell.sim.gige_head import GigeHead
-    from cell.sim.session import SimCell
-
-    with SimCell.start(small_cell.cell) as sim, GigeHead.for_camera(sim.camera) as head:
-        assert head.url == "gige://127.0.0.1,127.0.0.2"
+def test_aravis_own_tool_grabs_from_holecell_sim() -> None:
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    sim = subprocess.Popen([sys.executable, "-m", "cell.cli", "sim", "--camera-transport", "gige",
+                            "--duration-s", "120"], env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True)  # fmt: skip
+    try:
+        lines = [sim.stdout.readline() for _ in range(3)]
+        assert "camera      gige://127.0.0.1,127.0.0.2\n" in lines, lines
         for ip in ("127.0.0.1", "127.0.0.2"):
             r = subprocess.run(["arv-camera-test-0.8", "-n", ip, "-o", "4", "--duration", "3"],
                                capture_output=True, text=True, timeout=60)  # fmt: skip
@@ -81,7 +85,9 @@ def test_aravis_own_tool_grabs_from_the_simulated_head(small_cell) -> None:
             done = int(re.search(r"n_completed_buffers\s*=\s*(\d+)", out).group(1))
             failed = int(re.search(r"n_failures\s*=\s*(\d+)", out).group(1))
             assert done >= 1 and failed == 0, out
-        assert sim.camera.captures >= 2  # the frames were the simulator's renders
+    finally:
+        sim.terminate()
+        sim.wait(timeout=30)
 
 
 @in_netns
@@ -130,3 +136,31 @@ def test_a_persistent_fault_fails_that_capture_alone(kind: str, reason: str) -> 
         # (the first attempt's, with a newer id) is caught by its timestamp
         assert "intervals" in msg.split("retried:")[1], msg
     assert _same(first, renders.served[0]) and _same(after, renders.served[3])
+
+
+@in_netns
+def test_a_line_trigger_pulsed_over_rws_gives_one_pair_per_pulse() -> None:
+    from cell.controller.rws1 import Rws1Manager
+    from cell.sim.rws_server import RwsFake
+
+    head, renders = _head()
+    edges = []
+
+    def wire(name: str, value: int) -> None:  # the output wired to both cameras' Line0
+        if name == "Local/DRV_1/doCamTrigger" and value == 1:
+            edges.append(name)
+            head.pulse()
+
+    with head, RwsFake(on_signal=wire) as rws:
+        manager = Rws1Manager(rws.url, "Default User", "robotics")
+        cam = _client(head.url + FAST + "&trigger=line0&pair_ms=100")
+        cam.fire = lambda: manager.pulse("doCamTrigger")
+        try:
+            assert cam.left.camera.get_trigger_source() == "Line0"
+            pairs = [cam.capture() for _ in range(2)]
+            assert cam.retries == 0
+        finally:
+            cam.close()
+            manager.close()
+    assert len(edges) == 2 and rws.signals["Local/DRV_1/doCamTrigger"] == 0
+    assert all(_same(p, s) for p, s in zip(pairs, renders.served, strict=True))
