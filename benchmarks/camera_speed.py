@@ -60,35 +60,42 @@ def _measure(open_head, n: int) -> tuple[float, np.ndarray, int]:
 
 
 def run(n: int) -> None:
+    from cell.camera.aravis import aravis, clib
     from cell.camera.gige import GigeStereo
     from cell.camera.network import NetworkCamera
     from cell.sim.camserver import CameraServer
     from cell.sim.gige_head import GigeHead
     from measure.synth import standard_stereo
 
-    from cell.camera.aravis import aravis, clib
-
     aravis(), clib()  # the library loaded before anything is timed
     stereo = standard_stereo()
     rows = []
     with CameraServer(Pairs()).start() as srv:  # type: ignore[arg-type]
-        rows.append(("tcp:// (simulator)", "-", *_measure(lambda: NetworkCamera(srv.url, stereo), n)))
+        tcp = _measure(lambda: NetworkCamera(srv.url, stereo), n)
+        rows.append(("tcp:// (simulator)", "-", *tcp))
     for size in (1500, 8192, 9000):
         src = Pairs()
         with GigeHead(src.capture, SHAPE) as head:
             url = f"{head.url}?packet_size={size}"
-            rows.append(("gige:// (Aravis)", str(size), *_measure(lambda: GigeStereo(url, stereo), n)))
+            gige = _measure(lambda u=url: GigeStereo(u, stereo), n)
+            rows.append(("gige:// (Aravis)", str(size), *gige))
     mb = 2 * SHAPE[0] * SHAPE[1] / 1e6
-    print(f"\n5 MP stereo pairs ({mb:.1f} MB a pair) on loopback, {n} pairs each; load "
-          f"average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores\n")
-    print("| transport | packet size (B) | open (ms) | trigger-to-pair median / p95 / max (ms) "
-          "| pairs/s | MB/s | retries |")
+    print(
+        f"\n5 MP stereo pairs ({mb:.1f} MB a pair) on loopback, {n} pairs each; load "
+        f"average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores\n"
+    )
+    print(
+        "| transport | packet size (B) | open (ms) | trigger-to-pair median / p95 / max (ms) "
+        "| pairs/s | MB/s | retries |"
+    )
     print("|---|---|---|---|---|---|---|")
     for name, size, t_open, t, retries in rows:
         med, p95, mx = np.median(t) * 1e3, np.percentile(t, 95) * 1e3, t.max() * 1e3
         rate = 1.0 / t.mean()
-        print(f"| {name} | {size} | {t_open * 1e3:.0f} | {med:.0f} / {p95:.0f} / {mx:.0f} | "
-              f"{rate:.1f} | {rate * mb:.0f} | {retries} |")
+        print(
+            f"| {name} | {size} | {t_open * 1e3:.0f} | {med:.0f} / {p95:.0f} / {mx:.0f} | "
+            f"{rate:.1f} | {rate * mb:.0f} | {retries} |"
+        )
 
 
 def main() -> None:

@@ -85,7 +85,7 @@ class GigeDevice:
             try:
                 if self.camera.is_feature_available(feature):
                     return bool(self.camera.get_boolean(feature))
-            except Exception:  # noqa: S112 - a feature listed but not readable: not PTP
+            except Exception:
                 continue
         return False
 

@@ -11,8 +11,8 @@ from typing import Any
 from cell.commands.argtypes import positive_float
 from cell.config import load_cell
 from cell.controller.deploy import deploy
-from cell.errors import CellError
 from cell.controller.rws1 import Rws1Manager
+from cell.errors import CellError
 from cell.link.client import ControllerClient
 from cell.rapid.module import link_module, link_settings
 

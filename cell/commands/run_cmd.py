@@ -17,17 +17,17 @@ from cell.calibration.use import (
 )
 from cell.camera import cell_stereo
 from cell.camera.open import open_camera
-from cell.commands.controller_cmd import (
-    add_rws_arguments,
-    add_rws_trigger_argument,
-    trigger_pulse,
-    watched_client,
-)
 from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
     part_temperature_c,
     temperature_u_K,
+)
+from cell.commands.controller_cmd import (
+    add_rws_arguments,
+    add_rws_trigger_argument,
+    trigger_pulse,
+    watched_client,
 )
 from cell.commands.run_progress import RunBars
 from cell.config import CellConfig, load_cell
@@ -70,8 +70,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("tour", nargs="?", help="tour.json (not with --resume)")
     p.add_argument("--cell", help="cell file the tour was planned for")
     p.add_argument("--port", required=True, help="controller port URL")
-    p.add_argument("--camera", required=True, help="stereo head: tcp://HOST:PORT (the simulator) or "
-                   "gige://IP_LEFT,IP_RIGHT[?trigger=...] (GigE Vision, docs/real_cell.md)")
+    p.add_argument("--camera", required=True,
+                   help="stereo head: tcp://HOST:PORT (the simulator) or "
+                        "gige://IP_LEFT,IP_RIGHT[?trigger=...] (GigE Vision, "
+                        "docs/real_cell.md)")  # fmt: skip
     p.add_argument("--out", default=None, help="run directory to create (default: runs/<tour>)")
     p.add_argument("--resume", metavar="RUN_DIR", help="continue the run stored in RUN_DIR")
     p.add_argument("--thermal", help="thermal.json model to start from (holecell thermal)")

@@ -16,9 +16,9 @@ from cell.commands.argtypes import (
     positive_float,
     probability,
 )
+from cell.commands.sim_gige import add_camera_arguments, serve_head
 from cell.config import load_cell
 from cell.errors import CellError
-from cell.commands.sim_gige import add_camera_arguments, serve_head
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.truth import CellTruth

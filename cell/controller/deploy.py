@@ -40,9 +40,9 @@ def deploy(
     report = DeployReport()
     state = manager.state()
     if state.controller != "motoron":
-        raise ControllerError(manager.url, "start",
-                              f"motors are off (controller state {state.controller}, mode "
-                              f"{state.opmode}): switch the motors on, then deploy again")  # fmt: skip
+        why = (f"motors are off (controller state {state.controller}, mode {state.opmode}): "
+               "switch the motors on, then deploy again")  # fmt: skip
+        raise ControllerError(manager.url, "start", why)
     if state.execution == "running":
         manager.stop()
         report.steps.append("stop")

@@ -42,7 +42,8 @@ def link_module(settings: dict[str, object], text: str | None = None) -> str:
         if name not in SETTINGS:
             raise CellError(f"RAPID module: {name} is not a setting ({', '.join(SETTINGS)})")
         pattern = re.compile(rf"^(\s*CONST\s+{SETTINGS[name]}\s+{name}\s*:=\s*)[^;]*;", re.M)
-        text, n = pattern.subn(lambda m, v=_literal(name, value): f"{m.group(1)}{v};", text)
+        literal = _literal(name, value)
+        text, n = pattern.subn(lambda m, v=literal: f"{m.group(1)}{v};", text)
         if n != 1:
             raise CellError(f"RAPID module: CONST {name} found {n} times, expected once")
     return text

@@ -106,13 +106,15 @@ class _FakeCamera:
         self.ip, self.side, self.pairs = ip, side, pairs
         self.gv = Aravis.GvFakeCamera.new(ip, f"HOLECELL-{'LR'[side]}")
         if not self.gv.is_running():
-            raise CameraError(f"gige {ip}", "the fake camera did not start (is the address "
-                                            "on a local interface? see docs/real_cell.md)")  # fmt: skip
+            why = ("the fake camera did not start (is the address on a local interface? see "
+                   "docs/real_cell.md)")  # fmt: skip
+            raise CameraError(f"gige {ip}", why)
         self.fake = self.gv.get_fake_camera()
         self._ptr = gpointer(self.fake)
         h, w = shape
-        for reg, value in ((REG_SENSOR_WIDTH, w), (REG_SENSOR_HEIGHT, h), (REG_WIDTH, w),
-                           (REG_HEIGHT, h), (REG_HEARTBEAT_TIMEOUT, HEARTBEAT_TIMEOUT_MS)):  # fmt: skip
+        registers = ((REG_SENSOR_WIDTH, w), (REG_SENSOR_HEIGHT, h), (REG_WIDTH, w),
+                     (REG_HEIGHT, h), (REG_HEARTBEAT_TIMEOUT, HEARTBEAT_TIMEOUT_MS))  # fmt: skip
+        for reg, value in registers:
             lib.arv_fake_camera_write_register(self._ptr, reg, value)
         self.fake.set_trigger_frequency(TRIGGER_POLL_HZ)
         self.served = 0

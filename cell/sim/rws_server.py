@@ -25,7 +25,7 @@ REALM = "validusers@robapi.abb"
 
 
 def _md5(text: str) -> str:
-    return hashlib.md5(text.encode()).hexdigest()  # noqa: S324 - digest auth is MD5 here
+    return hashlib.md5(text.encode()).hexdigest()
 
 
 def _parse_digest(header: str) -> dict[str, str]:
@@ -111,8 +111,8 @@ class RwsFake:
         self._nonces.add(nonce)
         self.unauthorized += 1
         h.send_response(401)
-        h.send_header("WWW-Authenticate",
-                      f'Digest realm="{REALM}", qop="auth", nonce="{nonce}", algorithm=MD5')  # fmt: skip
+        challenge = f'Digest realm="{REALM}", qop="auth", nonce="{nonce}", algorithm=MD5'
+        h.send_header("WWW-Authenticate", challenge)
         h.send_header("Content-Type", "text/html")
         h.send_header("Content-Length", "0")
         h.end_headers()
@@ -131,7 +131,7 @@ class RwsFake:
             self.calls.append((method, path, action))
             try:
                 status, doc = self._route(method, path, action, body)
-            except _Refused as exc:
+            except _RefusedError as exc:
                 self.refused.append(str(exc))
                 status, doc = 400, {"_embedded": {"status": {"code": -1, "msg": str(exc)}}}
         session = secrets.token_hex(8)
@@ -170,7 +170,7 @@ class RwsFake:
         if path == "/rw/panel/ctrlstate" and action == "setctrlstate":
             self.ctrlstate = form.get("ctrl-state", self.ctrlstate)
             return 204, None
-        raise _Refused(f"{method} {path}?action={action}: not served by the fake")
+        raise _RefusedError(f"{method} {path}?action={action}: not served by the fake")
 
     def _get(self, path: str) -> Any:
         def state(*items: dict) -> dict:
@@ -189,16 +189,16 @@ class RwsFake:
                           "excstate": "ready", "active": "On", "motiontask": "TRUE"})  # fmt: skip
         if path == "/logout":
             return None
-        raise _Refused(f"GET {path}: not served by the fake")
+        raise _RefusedError(f"GET {path}: not served by the fake")
 
     def _loadmod(self, task: str, form: dict[str, str]) -> tuple[int, Any]:
         module = form.get("modulepath", "")
         if not self.mastership:
-            raise _Refused("loadmod without mastership")
+            raise _RefusedError("loadmod without mastership")
         if module not in self.files:
-            raise _Refused(f"loadmod: no file {module!r} on the controller")
+            raise _RefusedError(f"loadmod: no file {module!r} on the controller")
         if self.execution == "running":
-            raise _Refused("loadmod while RAPID runs")
+            raise _RefusedError("loadmod while RAPID runs")
         self.modules[task] = module
         self.pp_set = False
         return 204, None
@@ -206,12 +206,12 @@ class RwsFake:
     def _execution(self, action: str) -> tuple[int, Any]:
         if action == "resetpp":
             if not self.mastership or "T_ROB1" not in self.modules:
-                raise _Refused("resetpp without mastership or without a module loaded")
+                raise _RefusedError("resetpp without mastership or without a module loaded")
             self.pp_set = True
             return 204, None
         if action == "start":
             if self.ctrlstate != "motoron" or not self.pp_set:
-                raise _Refused("start with the motors off or no program pointer")
+                raise _RefusedError("start with the motors off or no program pointer")
             self.execution = "running"
             if self.on_start is not None:
                 path = self.modules["T_ROB1"]
@@ -222,8 +222,8 @@ class RwsFake:
             if self.on_stop is not None:
                 self.on_stop()
             return 204, None
-        raise _Refused(f"execution action {action!r}")
+        raise _RefusedError(f"execution action {action!r}")
 
 
-class _Refused(Exception):
+class _RefusedError(Exception):
     pass

@@ -121,9 +121,10 @@ def test_a_run_watched_over_rws_stops_cleanly_when_the_motors_go_off(
 
         client.connect()
         try:
+            options = RunOptions(settle_s=0.0, reference_rounds=0)
             with pytest.raises(RunFaultError, match="motors off"):
-                Runner(files.cell, files.tour, files.store, client, sim.camera,
-                       RunOptions(settle_s=0.0, reference_rounds=0), progress=progress).run()  # fmt: skip
+                Runner(files.cell, files.tour, files.store, client, sim.camera, options,
+                       progress=progress).run()  # fmt: skip
         finally:
             client.close()
             files.store.close()

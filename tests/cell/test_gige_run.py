@@ -60,19 +60,22 @@ def test_the_gige_head_gives_the_tcp_results(small_cell: SmallCell, tmp_path: Pa
     from cell.sim.gige_head import GigeFaults, GigeHead
 
     tcp = _tcp_reference(small_cell, tmp_path / "tcp")
-    with SimCell.start(small_cell.cell, WORLD, FaultPlan(seed=3)) as sim:
-        with GigeHead.for_camera(sim.camera) as head:
-            assert _run(small_cell, tmp_path / "gige", head.url + PATIENT, sim.url) == 0
+    with (
+        SimCell.start(small_cell.cell, WORLD, FaultPlan(seed=3)) as sim,
+        GigeHead.for_camera(sim.camera) as head,
+    ):
+        assert _run(small_cell, tmp_path / "gige", head.url + PATIENT, sim.url) == 0
     gige, _ = _results(tmp_path / "gige")
     assert len(gige) == len(tcp) == len(small_cell.tour.stops)
     for a, b in zip(gige, tcp, strict=True):
         _same(a, b)
     # the right camera drops its frame at stop 1, on the first attempt and on the retry
     faults = GigeFaults({"drop": frozenset({1})})
-    with SimCell.start(small_cell.cell, WORLD, FaultPlan(seed=3)) as sim:
-        with GigeHead.for_camera(sim.camera, faults=faults) as head:
-            url = head.url + "?timeout_ms=3000"
-            assert _run(small_cell, tmp_path / "drop", url, sim.url) == 0
+    with (
+        SimCell.start(small_cell.cell, WORLD, FaultPlan(seed=3)) as sim,
+        GigeHead.for_camera(sim.camera, faults=faults) as head,
+    ):
+        assert _run(small_cell, tmp_path / "drop", head.url + "?timeout_ms=3000", sim.url) == 0
     dropped, events = _results(tmp_path / "drop")
     assert [r.status == "unmeasured" for r in dropped] == [k == 1 for k in range(len(tcp))]
     assert "no stereo pair" in dropped[1].reason and "right frame dropped" in dropped[1].reason
@@ -105,8 +108,16 @@ def test_the_builtin_tour_through_holecell_sim_gige_matches_tcp(tmp_path: Path) 
     tour_path = tour.save(tmp_path / "tour.json")
     results = {}
     for transport in ("tcp", "gige"):
-        sim, port, camera = _serve("--seed", "5", "--speed", "20", "--drift-offset-s", "1e7",
-                                     "--camera-transport", transport)  # warm: no drift
+        sim, port, camera = _serve(
+            "--seed",
+            "5",
+            "--speed",
+            "20",
+            "--drift-offset-s",
+            "1e7",
+            "--camera-transport",
+            transport,
+        )  # warm: no drift
         try:
             if transport == "gige":
                 assert camera == "gige://127.0.0.1,127.0.0.2"
