@@ -138,3 +138,16 @@ def test_a_run_watched_over_rws_stops_cleanly_when_the_motors_go_off(
 def store_message(run_dir: Path) -> str:
     with Store.open(run_dir) as store:
         return store.events()[-1]["message"]
+
+
+def test_holecell_run_with_rws_refuses_a_controller_not_running_rapid(
+    small_cell: SmallCell, tmp_path: Path, capsys, monkeypatch
+) -> None:
+    monkeypatch.setenv("HOLECELL_RWS_PASSWORD", SECRET)
+    with SimCell.start(small_cell.cell) as sim, RwsFake(password=SECRET) as rws:
+        code = main(["run", str(small_cell.tour_path), "--cell", str(small_cell.path),
+                     "--port", sim.url, "--camera", "tcp://127.0.0.1:1", "--rws", rws.url,
+                     "--out", str(tmp_path / "run"), "--yes", "--quiet"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "RAPID execution stopped" in err and SECRET not in err
+    assert rws.unauthorized >= 1 and not (tmp_path / "run").exists()
