@@ -123,6 +123,13 @@ class _FakeCamera:
         lib.arv_fake_camera_set_fill_pattern(self._ptr, self._callback, None)
 
     def _fill(self, buf: int, _data: Any, _exp: int, _gain: int, _fmt: int) -> None:
+        try:
+            self._serve(buf)
+        except BaseException as exc:  # ctypes would print it and send the buffer's old image
+            log.exception("fake camera %s: %s", self.ip, exc)
+            self.gv.set_property("gvsp-lost-ratio", 1.0)
+
+    def _serve(self, buf: int) -> None:
         lib = clib()
         image, fault = self.pairs.take(self.side)
         w, h = lib.arv_buffer_get_image_width(buf), lib.arv_buffer_get_image_height(buf)
