@@ -5,9 +5,11 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 # test processes (pytest-xdist): the suite waits on simulated real time, so two share 2 cores well
 JOBS ?= 2
-# system libraries of the GigE Vision head (Aravis) and of building PyGObject (Debian 12 names;
-# other distributions: README.md)
-DEB_PACKAGES := aravis-tools gir1.2-aravis-0.8 libaravis-0.8-0 libgirepository1.0-dev libcairo2-dev
+# system libraries of the GigE Vision head (Aravis) and of building PyGObject, which has no
+# wheels: its build also needs pkg-config and Python's headers (Debian 12 names; other
+# distributions: README.md)
+DEB_PACKAGES := aravis-tools gir1.2-aravis-0.8 libaravis-0.8-0 libgirepository1.0-dev \
+	libcairo2-dev pkg-config python3-dev
 SYSDEPS := $(VENV)/.sysdeps
 
 .PHONY: demo test lint format bench clean
