@@ -14,6 +14,16 @@ from measure import StereoCalibration
 SCHEMES = ("tcp://", "gige://")
 
 
+def check_camera_url(url: str) -> None:
+    """Refuse a ``--camera`` URL that cannot name a head, before anything is connected."""
+    if url.startswith("gige://"):
+        from cell.camera.gige_url import parse_gige_url
+
+        parse_gige_url(url)
+    elif not url.startswith("tcp://"):
+        raise CameraError(url, f"unknown camera URL: expected {' or '.join(SCHEMES)}...")
+
+
 def open_camera(
     url: str, stereo: StereoCalibration, fire: Callable[[], None] | None = None
 ) -> CameraBackend:

@@ -16,7 +16,7 @@ from cell.calibration.use import (
     stored_calibration_path,
 )
 from cell.camera import cell_stereo
-from cell.camera.open import open_camera
+from cell.camera.open import check_camera_url, open_camera
 from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
@@ -243,6 +243,7 @@ def _ask_start() -> None:
 
 def run_run(args: argparse.Namespace) -> int:
     """Handler of ``holecell run``."""
+    check_camera_url(args.camera)
     cell, model, calibration, open_files = _prepare(args)
     client = watched_client(ControllerClient(args.port), args)
     camera = recorder = files = None

@@ -42,3 +42,12 @@ def test_mistakes_are_one_line(url: str, says: str) -> None:
 def test_an_unknown_scheme_is_refused() -> None:
     with pytest.raises(CameraError, match="expected tcp:// or gige://"):
         open_camera("usb3://1,2", standard_stereo())
+
+
+def test_holecell_run_refuses_a_bad_camera_url_before_connecting(capsys) -> None:
+    from cell.cli import main
+
+    code = main(["run", "tour.json", "--cell", "cell.yaml", "--port", "/dev/null/none",
+                 "--camera", "gige://left-cam,right-cam"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "'left-cam' is not an IPv4 address" in err
