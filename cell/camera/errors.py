@@ -12,3 +12,9 @@ class CameraError(CellError):
         self.source = source
         self.reason = reason
         super().__init__(f"camera {source}: {reason}")
+
+
+class PairError(CameraError):
+    """No stereo pair of one trigger could be had at a stop, after the retry: a frame dropped,
+    late or incomplete, or two frames of different triggers. The stop fails with ``reason``;
+    the cameras still answer, so the run goes on."""

@@ -15,13 +15,20 @@ from cell.calibration.use import (
     store_calibration,
     stored_calibration_path,
 )
-from cell.camera import NetworkCamera, cell_stereo
+from cell.camera import cell_stereo
+from cell.camera.open import check_camera_url, open_camera
 from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
     part_temperature_c,
     positive_float,
     temperature_u_K,
+)
+from cell.commands.controller_cmd import (
+    add_rws_arguments,
+    add_rws_trigger_argument,
+    trigger_pulse,
+    watched_client,
 )
 from cell.commands.run_progress import RunBars
 from cell.config import CellConfig, load_cell
@@ -68,7 +75,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("tour", nargs="?", help="tour.json (not with --resume)")
     p.add_argument("--cell", help="cell file the tour was planned for")
     p.add_argument("--port", required=True, help="controller port URL")
-    p.add_argument("--camera", required=True, help="stereo head: tcp://HOST:PORT")
+    p.add_argument("--camera", required=True,
+                   help="stereo head: tcp://HOST:PORT (the simulator) or "
+                        "gige://IP_LEFT,IP_RIGHT[?trigger=...] (GigE Vision, "
+                        "docs/real_cell.md)")  # fmt: skip
     p.add_argument("--out", default=None, help="run directory to create (default: runs/<tour>)")
     p.add_argument("--resume", metavar="RUN_DIR", help="continue the run stored in RUN_DIR")
     p.add_argument("--thermal", help="thermal.json model to start from (holecell thermal)")
@@ -142,6 +152,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--yes", action="store_true", help="start (and --reset) without asking")
     p.add_argument("--quiet", action="store_true", help="no progress display")
+    add_rws_arguments(p, prefix="rws-")  # --rws: watch the controller's state (RWS 1.0)
+    add_rws_trigger_argument(p)
     p.set_defaults(handler=run_run)
 
 
@@ -267,8 +279,9 @@ def _ask_start() -> None:
 
 def run_run(args: argparse.Namespace) -> int:
     """Handler of ``holecell run``."""
+    check_camera_url(args.camera)
     cell, model, calibration, open_files = _prepare(args)
-    client = ControllerClient(args.port)
+    client = watched_client(ControllerClient(args.port), args)
     camera = recorder = files = None
     try:
         client.connect()
@@ -280,7 +293,7 @@ def run_run(args: argparse.Namespace) -> int:
         _clear_fault(client, args)
         if model is not None:
             check_model_sensors(model, len(client.status().temperatures_c), args.thermal)
-        camera = NetworkCamera(args.camera, cell_stereo(cell))
+        camera = open_camera(args.camera, cell_stereo(cell), trigger_pulse(client, args))
         files = open_files()
         run_dir = files.store.path.parent
         if calibration is not None:

@@ -1,8 +1,8 @@
 """``holecell sim [CELL]``: the simulated controller and stereo head, stand-alone.
 
 For testing a cell computer (``holecell run``) against a simulated cell: prints the controller
-port (a pty path or ``socket://127.0.0.1:PORT``) and the camera URL (``tcp://127.0.0.1:PORT``),
-then serves until interrupted.
+port (a pty path or ``socket://127.0.0.1:PORT``) and the camera URL (``tcp://127.0.0.1:PORT``,
+or ``gige://127.0.0.1,127.0.0.2``: two GigE Vision fake cameras), then serves until interrupted.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from cell.commands.argtypes import (
     positive_float,
     probability,
 )
+from cell.commands.sim_gige import add_camera_arguments, serve_head
 from cell.config import load_cell
 from cell.errors import CellError
-from cell.sim.camserver import CameraServer
 from cell.sim.faults import FaultPlan
 from cell.sim.session import SimCell
 from cell.sim.truth import CellTruth
@@ -74,6 +74,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "are drawn from its seed, else --seed); default: no geometric error",
     )
     p.add_argument("--duration-s", type=positive_float, default=None, help="stop after this long")
+    add_camera_arguments(p)
     p.set_defaults(handler=run_sim)
 
 
@@ -98,7 +99,7 @@ def run_sim(args: argparse.Namespace) -> int:
              else CellTruth.load(args.truth, cell, seed=args.seed))  # fmt: skip
     world = WorldOptions(speed=args.speed, drift_offset_s=args.drift_offset_s, truth=truth)
     with SimCell.start(cell, world, faults, args.transport, controller=args.controller) as sim:
-        cam = CameraServer(sim.camera).start()
+        cam = serve_head(sim.camera, args)
         try:
             print(f"controller  {sim.url}", flush=True)
             print(f"camera      {cam.url}", flush=True)

@@ -126,6 +126,23 @@ def inspect_hole(
     return _decided(result, budget, ctx.rule), meas
 
 
+def uncaptured_hole(
+    cell: CellConfig,
+    hole: HoleInCell,
+    stop_index: int,
+    reason: str,
+    q_rad: np.ndarray,
+    temps_c: np.ndarray,
+    sim_time_s: float,
+) -> HoleResult:
+    """The result of a stop where the head gave no pair of one trigger (``reason``, from
+    :class:`cell.camera.errors.PairError`): ``unmeasured``, so a resume measures it again."""
+    T_part_cell = invert(cell.T_cell_part())
+    nominal = T_part_cell[:3, :3] @ hole.position_m + T_part_cell[:3, 3]
+    base = _base_fields(hole, stop_index, nominal, q_rad, temps_c, sim_time_s)
+    return HoleResult(status="unmeasured", reason=f"no stereo pair: {reason}", **base)
+
+
 def _calibration_factor(
     arm: Arm | RunGeometry, q_rad: np.ndarray, center_left_m: np.ndarray, R_part_cell: np.ndarray
 ) -> tuple[np.ndarray | None, str]:

@@ -21,6 +21,7 @@ import numpy as np
 
 from cell.calibration.use import RunCalibration, RunGeometry, calibrated_stereo, correct_tour
 from cell.camera import CameraBackend
+from cell.camera.errors import PairError
 from cell.config import CellConfig
 from cell.config.markers import marker_codes
 from cell.errors import CellError
@@ -31,7 +32,7 @@ from cell.records.hole_result import HoleResult
 from cell.referencing.detection import detect_pair, label_circles
 from cell.referencing.network import MarkerNetwork
 from cell.review.store import Store
-from cell.run.inspect import T_cell_tcp, inspect_hole
+from cell.run.inspect import T_cell_tcp, inspect_hole, uncaptured_hole
 from cell.run.reference import target_of
 from cell.run.referenced import ARM_DISAGREEMENT_M, LocatedStop, locate_stop
 from cell.run.thermal_record import remember_model, stored_model, stored_rows
@@ -318,14 +319,14 @@ class Runner(Motion):
             for k, s in enumerate(tour.stops):
                 self._move(k, f"reference {s.hole_id}")
                 st = self._settled_status()
-                pair = self.camera.capture()
-                exclude = None
-                if self.codes:  # the markers' labels are not the reference target
-                    dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
-                    exclude = label_circles(dets)
                 try:
+                    pair = self.camera.capture()
+                    exclude = None
+                    if self.codes:  # the markers' labels are not the reference target
+                        dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
+                        exclude = label_circles(dets)
                     meas = measure_hole(pair.left, pair.right, self.stereo, exclude=exclude)
-                except MeasurementError as exc:
+                except (MeasurementError, PairError) as exc:
                     self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
                     continue
                 p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
@@ -377,7 +378,10 @@ class Runner(Motion):
         clock.lap("move_s")
         st = self._settled_status()
         clock.lap("settle_s")
-        pair = self.camera.capture()
+        try:
+            pair = self.camera.capture()
+        except PairError as exc:  # no pair of one trigger: this stop fails, the run goes on
+            return self._uncaptured(k, stop.hole_id, exc, st, clock)
         clock.lap("capture_s")
         T_arm = (T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
                  @ self._T_head_left)  # the arm's idea of the left camera  # fmt: skip
@@ -404,6 +408,17 @@ class Runner(Motion):
         clock.lap("record_s")
         self.progress("hole", {"stop": k, "result": result})
         clock.laps["measure_s"] = result.measure_time_s
+        return result, clock.laps
+
+    def _uncaptured(self, k: int, hole_id: str, exc: PairError, st, clock: _Laps
+                    ) -> tuple[HoleResult, dict[str, float]]:  # fmt: skip
+        """Store stop ``k`` as unmeasured with the camera's reason (a resume retries it)."""
+        clock.lap("capture_s")
+        result = uncaptured_hole(self.cell, self.holes[hole_id], k, exc.reason, st.q_rad,
+                                 st.temperatures_c, st.time_s)  # fmt: skip
+        self.store.event("camera", f"stop {k} ({hole_id}): {exc}")
+        self.store.record_hole(result)
+        self.progress("hole", {"stop": k, "result": result})
         return result, clock.laps
 
 

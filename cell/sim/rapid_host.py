@@ -143,7 +143,9 @@ class SimSocket:
             raise RapidRunError("ERR_ARGVALERR", f"port {port}")
         s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        s.bind(("127.0.0.1", 0))
+        # a module set for this machine's loopback binds its port; any other address (the
+        # controller's own) is simulated on a free loopback port
+        s.bind(("127.0.0.1", port if address == "127.0.0.1" else 0))
         self.sock, self.state = s, "SOCKET_BOUND"
         self.host.bound_port = s.getsockname()[1]
 
