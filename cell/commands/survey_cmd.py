@@ -26,7 +26,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description=DESCRIPTION)  # fmt: skip
     p.add_argument("cell", nargs="?", default=None, help="cell file (default: built-in)")
     p.add_argument("--port", required=True, help="controller port URL")
-    p.add_argument("--camera", required=True, help="stereo head: tcp://HOST:PORT")
+    p.add_argument(
+        "--camera", required=True, help="stereo head: tcp://HOST:PORT or gige://IP_LEFT,IP_RIGHT"
+    )
     p.add_argument("-o", "--output", default="markers.json", help="file to write (markers.json)")
     p.add_argument(
         "--settle-s",
@@ -65,7 +67,8 @@ def _progress(quiet: bool):
 
 def run(args: argparse.Namespace) -> int:
     """Handler: plan the survey tour, connect, run, adjust, report, write."""
-    from cell.camera import NetworkCamera, cell_stereo
+    from cell.camera import cell_stereo
+    from cell.camera.open import check_camera_url, open_camera
     from cell.commands.survey_report import print_survey
     from cell.config import load_cell
     from cell.errors import CellError
@@ -76,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
 
     out = Path(args.output)
     _check_output(out)
+    check_camera_url(args.camera)
     cell = load_cell(args.cell)
     if not cell.reference_markers:
         raise CellError(f"cell {cell.name!r}: reference_markers: the cell has none to survey")
@@ -96,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
         if client.identity.robot_model != cell.robot.model:
             raise CellError(f"controller at {args.port} drives {client.identity.robot_model!r}, "
                             f"the cell has {cell.robot.model!r}")  # fmt: skip
-        camera = NetworkCamera(args.camera, stereo)
+        camera = open_camera(args.camera, stereo)
         done = run_survey(cell, planned, client, camera, stereo,
                           SurveyRunOptions(args.settle_s, args.sigma_px),
                           _progress(args.quiet))  # fmt: skip
