@@ -148,7 +148,7 @@ def format_survey(res: DemoResult) -> str:
     r = v.result
     refs = [h.extra.get("referencing", {}) for h in res.run.stored]
     n_ref = sum(1 for x in refs if x.get("referenced"))
-    flagged = sum(1 for x in refs if x.get("arm_disagreement_m", 0.0) > 1e-3)
+    flagged = sum(1 for x in refs if (x.get("arm_registered_m") or 0.0) > 1e-3)
     rows = [
         ("marker survey", f"{len(r.marker_ids)} markers from {r.n_views} views, "
                           f"{r.rms_px:.3f} px RMS, {v.robot_time_s:.0f} s robot time, "
@@ -156,7 +156,8 @@ def format_survey(res: DemoResult) -> str:
         ("  vs true markers", f"{v.rms_m * 1e6:.1f} um RMS (max {v.worst_m * 1e6:.1f} um) after "
                               f"a rigid fit; scale sigma {r.scale_sigma_ppm:.1f} ppm"),
         ("  stops referenced", f"{n_ref}/{len(refs)} located against the markers"
-                               + (f"; {flagged} off the arm by > 1 mm" if flagged else "")),
+                               + (f"; {flagged} off the registered arm by > 1 mm"
+                                  if flagged else "")),
         ("  file", str(v.path)),
     ]  # fmt: skip
     width = max(len(k) for k, _ in rows)

@@ -57,7 +57,8 @@ def _figures(doc: dict[str, Any]) -> str:
 
 def _stops(results: list[HoleResult]) -> str:
     head = ("<tr><th>hole</th><th>referenced</th><th>markers used</th><th>refused</th>"
-            "<th>arm vs markers (mm)</th><th>resection RMS (px)</th></tr>")  # fmt: skip
+            "<th>arm vs markers: raw / registered (mm)</th>"
+            "<th>resection RMS (px)</th></tr>")  # fmt: skip
     body = []
     for r in results:
         ref = r.extra.get("referencing")
@@ -66,12 +67,14 @@ def _stops(results: list[HoleResult]) -> str:
         refused = "; ".join(f"{k}: {v}" for k, v in ref.get("refused", {}).items())
         if ref.get("referenced"):
             d = ref.get("arm_disagreement_m", float("nan")) * 1e3
-            flag = " style='color:#c62828'" if d > 1.0 else ""
+            g = ref.get("arm_registered_m")
+            reg = "-" if g is None else f"{g * 1e3:.3f}"
+            flag = " style='color:#c62828'" if g is not None and g > 1e-3 else ""
             cells = (
                 "yes",
                 " ".join(ref.get("markers", [])),
                 refused,
-                f"<span{flag}>{d:.3f}</span>",
+                f"{d:.3f} / <span{flag}>{reg}</span>",
                 f"{ref.get('rms_px', float('nan')):.3f}",
             )
         else:

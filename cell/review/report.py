@@ -99,7 +99,7 @@ def _referencing_counts(results: list[HoleResult]) -> dict[str, Any]:
         return {"holes_referenced": None, "holes_fallback": None, "holes_arm_disagreement": None}
     return {"holes_referenced": sum(bool(x.get("referenced")) for x in refs),
             "holes_fallback": sum(not x.get("referenced") for x in refs),
-            "holes_arm_disagreement": sum(x.get("arm_disagreement_m", 0.0) > 1e-3
+            "holes_arm_disagreement": sum((x.get("arm_registered_m") or 0.0) > 1e-3
                                           for x in refs)}  # fmt: skip
 
 

@@ -3,9 +3,11 @@
 At a referenced stop the markers are detected in both images of the hole's pair and the head's
 pose in the cell is solved by stereo resection (:func:`cell.referencing.resect`) about the arm's
 prior (its kinematics, calibration and thermal model). The hole is then carried into the cell by
-the resected pose, not by the arm. The arm's prior identifies the markers' expected places and
-is compared with the resection: a difference over :data:`ARM_DISAGREEMENT_M` is flagged (a bumped
-fixture, a moved marker, a wrong calibration). With fewer than four usable markers the stop is
+the resected pose, not by the arm. The arm's prior removes the markers' perspective bias and
+starts the resection; once registered to the markers' frame (:class:`ArmRegistration`) it is
+compared with the resection: a difference over :data:`ARM_DISAGREEMENT_M` is flagged (a bumped
+fixture, a moved marker group, a wrong calibration). The markers are identified by their codes,
+not by the prior. With fewer than four usable markers the stop is
 not referenced and the run uses the arm, as without referencing, with its own (larger) budget.
 
 Budget of a referenced stop (part frame, m²): the circle fit, the head's calibration (as without
@@ -29,23 +31,64 @@ from cell.referencing.network import MarkerNetwork
 from cell.referencing.observations import MarkerView
 from cell.referencing.resection import Resection, resect
 from cell.uncertainty.budget import Contribution
+from robots.transforms import kabsch
 
 Array = NDArray[np.float64]
 
 #: the resected head and the arm's idea of it may differ by this much before it is flagged (m)
 ARM_DISAGREEMENT_M = 1e-3
+#: referenced stops needed before the arm is registered to the markers' frame
+MIN_REGISTRATION_STOPS = 3
+
+
+class ArmRegistration:
+    """The rigid motion from the arm's cell frame to the markers' (the survey's gauge), fitted
+    to every referenced stop so far.
+
+    The two frames differ by a rigid motion of the order of a millimetre: the arm's is its
+    calibration's (the plate's nominal pose), the markers' is the survey's gauge (the fixture
+    markers' nominal places). A stop is judged by how far its resected pose lies from the arm's
+    once registered: a jump is a bumped fixture, a moved marker group or a wrong kinematic
+    chain, not the frames' offset. Each pose is represented by three points: the camera's
+    centre, a point 0.25 m down its view axis and one 0.1 m along its x axis.
+    """
+
+    def __init__(self) -> None:
+        self.arm: list[Array] = []
+        self.markers: list[Array] = []
+
+    @staticmethod
+    def _points(T: Array) -> Array:
+        o = T[:3, 3]
+        return np.array([o, o + 0.25 * T[:3, 2], o + 0.1 * T[:3, 0]])
+
+    def add(self, T_cell_left_arm: Array, T_cell_left_markers: Array) -> None:
+        self.arm.append(self._points(T_cell_left_arm))
+        self.markers.append(self._points(T_cell_left_markers))
+
+    def residual_m(self, T_cell_left_arm: Array, T_cell_left_markers: Array) -> float:
+        """Largest distance (m) of the stop's points after registering the arm to the markers
+        on the stops so far (NaN before :data:`MIN_REGISTRATION_STOPS`)."""
+        if len(self.arm) < MIN_REGISTRATION_STOPS:
+            return math.nan
+        R, t, _ = kabsch(np.vstack(self.arm), np.vstack(self.markers)[None])
+        P = self._points(T_cell_left_arm) @ R[0].T + t[0]
+        return float(np.linalg.norm(P - self._points(T_cell_left_markers), axis=1).max())
 
 
 @dataclass(frozen=True, eq=False)
 class LocatedStop:
     """A stop's resection (``resection.ok`` False: not referenced, ``resection.reason`` why),
-    the markers seen (``view``), and how far the arm's prior was from it (m, rad)."""
+    the markers seen (``view``), how far the arm's prior was from it (m, rad), and how far once
+    the arm is registered to the markers' frame (``registered_m``, :class:`ArmRegistration`;
+    NaN before enough stops)."""
 
     resection: Resection
     view: MarkerView
     T_cell_left_arm: Array
     disagreement_m: float
     disagreement_rad: float
+    registered_m: float = math.nan
 
     @property
     def referenced(self) -> bool:
@@ -53,8 +96,9 @@ class LocatedStop:
 
     @property
     def flagged(self) -> bool:
-        """The resection and the arm disagree by more than :data:`ARM_DISAGREEMENT_M`."""
-        return self.referenced and self.disagreement_m > ARM_DISAGREEMENT_M
+        """The resection and the registered arm disagree by more than
+        :data:`ARM_DISAGREEMENT_M`."""
+        return self.referenced and self.registered_m > ARM_DISAGREEMENT_M
 
     def to_dict(self) -> dict[str, Any]:
         """What a hole result stores of it (``extra["referencing"]``)."""
@@ -69,6 +113,8 @@ class LocatedStop:
         if self.referenced:
             out |= {"rms_px": r.rms_px, "arm_disagreement_m": self.disagreement_m,
                     "arm_disagreement_rad": self.disagreement_rad,
+                    "arm_registered_m": None if math.isnan(self.registered_m)
+                    else self.registered_m,
                     "T_cell_left": r.T_cell_left.tolist(),
                     "T_cell_left_arm": self.T_cell_left_arm.tolist()}  # fmt: skip
         else:

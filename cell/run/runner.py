@@ -34,7 +34,12 @@ from cell.referencing.network import MarkerNetwork
 from cell.review.store import Store
 from cell.run.inspect import T_cell_tcp, inspect_hole, uncaptured_hole
 from cell.run.reference import target_of
-from cell.run.referenced import ARM_DISAGREEMENT_M, LocatedStop, locate_stop
+from cell.run.referenced import (
+    ARM_DISAGREEMENT_M,
+    ArmRegistration,
+    LocatedStop,
+    locate_stop,
+)
 from cell.run.thermal_record import remember_model, stored_model, stored_rows
 from cell.run.thermal_update import ThermalUpdate
 from cell.uncertainty.context import BudgetContext, budget_context
@@ -140,6 +145,7 @@ class Runner(Motion):
         # a referenced run measures with the head as the survey self-calibrated it
         self.markers = markers
         self.codes = marker_codes(cell.reference_markers)
+        self.registration = ArmRegistration()
         self.stereo = (markers.head if markers is not None
                        else calibrated_stereo(camera.stereo, calibration))  # fmt: skip
         self.geometry = RunGeometry(self.arm, self.stereo, calibration,
@@ -391,6 +397,13 @@ class Runner(Motion):
             exclude = label_circles(dets)
             if self.markers is not None:
                 located = locate_stop(self.markers, dets, T_arm, stop.hole_id)
+                if located.referenced:
+                    T_res = located.resection.T_cell_left
+                    located = replace(
+                        located, registered_m=self.registration.residual_m(T_arm, T_res)
+                    )
+                    if not located.flagged:  # a stop off the others does not move the fit
+                        self.registration.add(T_arm, T_res)
                 self._note_located(stop.hole_id, located)
         clock.lap("locate_s")
         result, meas = inspect_hole(self.cell, self.geometry, self.model, self.stereo,
@@ -432,10 +445,10 @@ def _located_note(hole_id: str, located: LocatedStop) -> tuple[str, str] | None:
         refused = "; ".join(f"{m}: {why}" for m, why in r.refused.items())
         return "referencing", f"{hole_id}: marker(s) refused: {refused}"
     if located.flagged:
-        return "fault", (f"{hole_id}: the markers place the head {located.disagreement_m * 1e3:.2f}"
-                         f" mm from where the arm says it is (over "
-                         f"{ARM_DISAGREEMENT_M * 1e3:g} mm): a bumped fixture, moved markers "
-                         "or a wrong calibration?")  # fmt: skip
+        return "fault", (f"{hole_id}: the markers place the head {located.registered_m * 1e3:.2f}"
+                         " mm from where the arm, registered to them on the stops before, says "
+                         f"it is (over {ARM_DISAGREEMENT_M * 1e3:g} mm): a bumped fixture, moved "
+                         "markers or a wrong calibration?")  # fmt: skip
     return None
 
 

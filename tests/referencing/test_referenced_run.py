@@ -113,7 +113,8 @@ def test_every_stop_is_located_against_the_markers(small_cell, tour, surveyed, t
     assert all(r.status == "ok" for r in results), [(r.hole_id, r.reason) for r in results]
     refs = [r.extra["referencing"] for r in results]
     assert all(x["referenced"] and len(x["markers"]) >= 4 and not x["refused"] for x in refs)
-    assert all(x["arm_disagreement_m"] < 1e-3 for x in refs)
+    assert all(x["arm_disagreement_m"] < 1e-3 for x in refs)  # a calibrated arm: no offset
+    assert all(x["arm_registered_m"] is None or x["arm_registered_m"] < 0.2e-3 for x in refs)
     rows = {c["name"] for r in results for c in r.budget["components"]}
     assert {"resection", "survey_markers"} <= rows
     assert not rows & {"robot_repeatability", "thermal_model", "cell_calibration"}
