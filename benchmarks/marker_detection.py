@@ -15,7 +15,8 @@ read noise 1–3 DN, 8 bits. Each marker seen by a camera is one observation. Pr
 3. the table of 1. on stress views beyond the detectors' limits (``STRESS``: blur σ 2-3.5 px,
    noise 3-6 DN, 5 mm dots at 0.6-1.2 m, tilts to 75°), where reads fail: refused or misread;
 4. false detections on hole-only scenes (:func:`measure.synth.render_hole_pair`, standard and
-   realistic options).
+   realistic options);
+5. the time to draw a stop's markers into one image.
 
 Run: ``PYTHONPATH=. python benchmarks/marker_detection.py [--views 40] [--stress 20] [--holes 10]``.
 """
@@ -259,6 +260,27 @@ def hole_scenes(n: int) -> None:
         print(f"| {d.kind} | {counts[d.kind]} |")
 
 
+def render_times(repeats: int = 5) -> None:
+    """Time to draw a stop's markers into one image: 4 and 12 markers (5 mm dots, 0.25 m)."""
+    from measure.synth.marker_draw import draw_markers
+
+    st = standard_stereo()
+    print("\n## Drawing markers into one image (5 mm dots at 0.25 m, 20° tilt)\n")
+    print("| design | markers | ms per image (best of 5) |\n|---|---|---|")
+    for d in DESIGNS:
+        for n in (4, 12):
+            ms = marker_grid_view(st, np.random.default_rng(n), d, 0.005, 0.25, 20.0, n)
+            ms = (ms * n)[:n]  # the view holds fewer: repeat them (the cost is the same)
+            img = np.zeros((st.image_size[1], st.image_size[0]), np.float32)
+            draw_markers(img, st, "left", ms, 0.7, 0.25)
+            best = float("inf")
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                draw_markers(img, st, "left", ms, 0.7, 0.25)
+                best = min(best, time.perf_counter() - t0)
+            print(f"| {d.kind} | {n} | {best * 1000:.0f} |")
+
+
 def print_designs() -> None:
     print("\n## Designs\n")
     print("| design | codes | printed radius (dot diameters) | 5 mm dot: radius (mm) |")
@@ -284,6 +306,7 @@ def main() -> None:
         st_obs, st_times, st_ghosts = run_views(args.stress, args.seed + 1000, STRESS)
         print_summary(st_obs, st_times, st_ghosts, f"Stress views {STRESS}")
     hole_scenes(args.holes)
+    render_times()
     print(f"\n({args.views} views per design, {time.time() - t0:.0f} s wall)")
 
 
