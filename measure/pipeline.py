@@ -9,6 +9,7 @@ correction + DLT) → Levenberg–Marquardt spatial circle fit with outlier reje
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -166,6 +167,17 @@ def _suspect_reasons(
     return tuple(out)
 
 
+#: a circle in image pixels: centre x, centre y, radius
+Circle = tuple[float, float, float]
+
+
+def _outside(cands: list[HoleCandidate], circles: Sequence[Circle]) -> list[HoleCandidate]:
+    """The candidates whose centre lies in none of ``circles``."""
+    return [c for c in cands
+            if all((c.centroid_px[0] - x) ** 2 + (c.centroid_px[1] - y) ** 2 > r * r
+                   for x, y, r in circles)]  # fmt: skip
+
+
 def _pick(cand_l, cand_r, oth_l, oth_r, pair_args):
     """The left/right pair (:func:`measure.pairing.pick_pair`); when none of the returned
     candidates pair, each polarity is tried once more with the other polarity's holes
@@ -205,6 +217,7 @@ def measure_hole(
     roi=None,
     options: MeasureOptions | None = None,
     expected_standoff_m: float | None = None,
+    exclude: tuple[Sequence[Circle], Sequence[Circle]] | None = None,
 ) -> HoleMeasurement:
     """Measure one hole from a stereo pair.
 
@@ -221,6 +234,9 @@ def measure_hole(
         options: :class:`MeasureOptions`.
         expected_standoff_m: nominal depth of the hole (metres, left frame); candidate
             pairs whose disparity puts them outside half to twice this depth are ruled out.
+        exclude: per image (left, right), circles ``(x_px, y_px, radius_px)`` known not to
+            hold the hole (reference markers' black labels, which look like dark discs): a
+            candidate whose centre lies in one is not considered.
 
     Returns:
         :class:`HoleMeasurement` in the LEFT camera optical frame (metres).
@@ -241,6 +257,9 @@ def measure_hole(
     st_l, st_r, oth_l, oth_r = {}, {}, [], []
     found_l = find_candidates(small_l, roi_l, stats=st_l, others=oth_l)
     found_r = find_candidates(small_r, roi_r, stats=st_r, others=oth_r)
+    if exclude is not None:
+        found_l, oth_l = _outside(found_l, exclude[0]), _outside(oth_l, exclude[0])
+        found_r, oth_r = _outside(found_r, exclude[1]), _outside(oth_r, exclude[1])
     cand_l = _usable(found_l, "left", roi_l, left.shape, st_l)
     cand_r = _usable(found_r, "right", roi_r, right.shape, st_r)
     # a lit background's lens → the whole opening (measure.opening)

@@ -118,4 +118,30 @@ def run_show(args: argparse.Namespace) -> int:
     legend = "* reference target" + ("; # calibration target's centre (diam: its pitch)"
                                      if cfg.calibration_target is not None else "")  # fmt: skip
     print(f"\n{legend}.  {len(rows) - unreachable} of {len(rows)} reachable.")
+    _markers(cfg)
     return 1 if unreachable else 0
+
+
+def _markers(cfg: CellConfig) -> None:
+    """The reference markers each hole's stop sees in both cameras (docs/referencing.md); the
+    holes whose stop cannot be located against 4 well-spread markers are named."""
+    if not cfg.reference_markers:
+        return
+    from cell.camera import cell_stereo
+    from cell.referencing.layout import markers_seen_per_hole
+
+    seen = markers_seen_per_hole(cfg, cell_stereo(cfg))
+    fixture = sum(m.on == "fixture" for m in cfg.reference_markers)
+    print(f"\nreference markers: {len(cfg.reference_markers)} ({fixture} on the fixture), "
+          f"{_count(len(cfg.scale_bars), 'scale bar')}; seen by each hole's stop in both "
+          "cameras (the worse of roll 0 and 90 deg):")  # fmt: skip
+    for hid, ids in seen.items():
+        print(f"  {hid:8s} {len(ids):2d}  {' '.join(ids)}")
+    short = [h for h, ids in seen.items() if len(ids) < 4]
+    if short:
+        print(
+            f"cannot be located against 4 well-spread markers: {', '.join(short)} (these stops "
+            "fall back to the arm)"
+        )
+    else:
+        print(f"every hole's stop sees at least 4 well-spread markers ({len(seen)} holes)")

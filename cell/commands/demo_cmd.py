@@ -84,6 +84,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "120 views); projected: the plate's corners projected through the simulated cell at "
         "the calibration planner's views (seconds, no detector)",
     )
+    p.add_argument(
+        "--no-referencing",
+        action="store_true",
+        help="do not survey the reference markers: carry every hole into the part by the arm "
+        "(default: survey the markers after the calibration, DIR/markers.json, and locate every "
+        "stop against them; docs/referencing.md)",
+    )
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
@@ -133,6 +140,29 @@ def format_calibration(res: DemoResult) -> str:
     return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
 
 
+def format_survey(res: DemoResult) -> str:
+    """The survey's figures and how many stops were referenced."""
+    v = res.survey
+    if v is None:
+        return "referencing: none (every hole carried into the part by the arm)"
+    r = v.result
+    refs = [h.extra.get("referencing", {}) for h in res.run.stored]
+    n_ref = sum(1 for x in refs if x.get("referenced"))
+    flagged = sum(1 for x in refs if x.get("arm_disagreement_m", 0.0) > 1e-3)
+    rows = [
+        ("marker survey", f"{len(r.marker_ids)} markers from {r.n_views} views, "
+                          f"{r.rms_px:.3f} px RMS, {v.robot_time_s:.0f} s robot time, "
+                          f"{v.seconds:.1f} s"),
+        ("  vs true markers", f"{v.rms_m * 1e6:.1f} um RMS (max {v.worst_m * 1e6:.1f} um) after "
+                              f"a rigid fit; scale sigma {r.scale_sigma_ppm:.1f} ppm"),
+        ("  stops referenced", f"{n_ref}/{len(refs)} located against the markers"
+                               + (f"; {flagged} off the arm by > 1 mm" if flagged else "")),
+        ("  file", str(v.path)),
+    ]  # fmt: skip
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
+
+
 def format_demo(res: DemoResult) -> str:
     """The summary table (mm and um for people)."""
     s, t, tr, dt = res.summary, res.timings, res.truth, res.datum
@@ -168,7 +198,8 @@ def format_demo(res: DemoResult) -> str:
         ("link", f"{res.run.link.get('requests', 0)} requests, "
                  f"{res.run.link.get('retransmits', 0)} retransmitted"),
         ("wall time", f"{t['total_s']:.1f} s (plan {t['plan_s']:.1f} s, calibration "
-                      f"{t.get('calibration_s', 0.0):.1f} s, run {t['run_s']:.1f} s)"),
+                      f"{t.get('calibration_s', 0.0):.1f} s, survey "
+                      f"{t.get('survey_s', 0.0):.1f} s, run {t['run_s']:.1f} s)"),
         ("run directory", str(res.run_dir)),
     ]  # fmt: skip
     width = max(len(k) for k, _ in rows)
@@ -230,12 +261,14 @@ def run_demo_cmd(args: argparse.Namespace) -> int:
             calibrate=not args.no_calibration,
             calibration_views=args.calibration_views,
             calibration_method=args.calibration_method,
+            referencing=not args.no_referencing,
         ),
         _plan_bars(args.quiet),
         _progress(bars),
         _recorder_factory(args),
     )
     print(format_calibration(res))
+    print(format_survey(res))
     print(format_demo(res))
     if not args.no_record:
         print(f"open the recording:  rerun {out / 'run.rrd'}")

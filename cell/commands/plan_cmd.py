@@ -159,6 +159,11 @@ def plan_cell(
     """Plan one cell: in this process (one start, stage bars) or multi-start on ``engine``."""
     if engine is None:
         progress = None if args.quiet else StageBars()
+        if getattr(cell, "reference_markers", None):  # viewpoints that see the markers
+            from cell.camera import cell_stereo
+            from cell.referencing.viewpoints import MarkerAwarePlanner
+
+            return MarkerAwarePlanner(cell, cell_stereo(cell), options, progress).plan(cell)
         return TourPlanner(options, progress).plan(cell)
     if not args.quiet:
         print(f"planning {args.starts} start(s) on {engine.name} ...", file=sys.stderr)

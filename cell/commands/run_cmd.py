@@ -20,6 +20,7 @@ from cell.commands.argtypes import (
     non_negative_float,
     non_negative_int,
     part_temperature_c,
+    positive_float,
     temperature_u_K,
 )
 from cell.commands.run_progress import RunBars
@@ -28,6 +29,9 @@ from cell.config.tours import check_tour
 from cell.errors import CellError
 from cell.link import messages as m
 from cell.link.client import ControllerClient
+from cell.referencing.markersfile import MARKERS_FILENAME
+from cell.referencing.markersfile import MAX_AGE_DAYS as MARKERS_MAX_AGE_DAYS
+from cell.referencing.network import load_network
 from cell.review.recording import Recorder
 from cell.review.report import format_summary, write_report
 from cell.run.reference import plan_reference_tour
@@ -36,6 +40,7 @@ from cell.run.setup import RunFiles, check_new_run_dir, resume_run, start_run
 from cell.run.thermal_check import check_model_for_cell, check_model_sensors
 from cell.uncertainty.decision import DECISION_RULES, DEFAULT_RULE
 from planner import load_tour
+from robots.files import write_text_atomic
 from robots.thermal.model import ThermalModel
 from robots.thermal.modelfile import load_model
 
@@ -80,6 +85,22 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=MAX_AGE_DAYS,
         metavar="DAYS",
         help=f"refuse a calibration older than this (default {MAX_AGE_DAYS:g} days)",
+    )
+    p.add_argument(
+        "--markers",
+        metavar="MARKERS.json",
+        help="the surveyed reference markers (holecell survey): every stop is located "
+        "against the markers it sees and the hole carried into the part by that "
+        "pose, not by the arm (a stop with fewer than 4 markers falls back to "
+        "the arm, flagged). Refused when surveyed for another cell or head, or "
+        "older than --markers-max-age",
+    )
+    p.add_argument(
+        "--markers-max-age",
+        type=positive_float,
+        default=MARKERS_MAX_AGE_DAYS,
+        metavar="DAYS",
+        help=f"refuse a survey older than this (default {MARKERS_MAX_AGE_DAYS:g} days)",
     )
     p.add_argument("--reference-rounds", type=non_negative_int, default=2,
                    help="rounds over the reference targets before the holes, "
@@ -158,6 +179,19 @@ def _calibration(
                                 args.calibration_max_age)  # fmt: skip
 
 
+def _markers(args: argparse.Namespace, cell: CellConfig, run_dir: Path | None):
+    """``--markers`` checked for ``cell`` (layout, head, age), or the copy a resumed run
+    stored (not its age); None: not referenced."""
+    if run_dir is not None:
+        if args.markers:
+            raise CellError("--resume uses the markers stored with the run; do not give --markers")
+        stored = run_dir / MARKERS_FILENAME
+        return load_network(stored, cell, cell_stereo(cell), None) if stored.exists() else None
+    if not args.markers:
+        return None
+    return load_network(args.markers, cell, cell_stereo(cell), args.markers_max_age)
+
+
 def _prepare(
     args: argparse.Namespace,
 ) -> tuple[CellConfig, ThermalModel | None, RunCalibration | None, Callable[[], RunFiles]]:
@@ -170,6 +204,7 @@ def _prepare(
         files = resume_run(args.resume)  # checked now, reopened once the cell answers
         files.store.close()
         cal = _calibration(args, files.cell, Path(args.resume))
+        args.network = _markers(args, files.cell, Path(args.resume))
         model = _thermal_model(args.thermal, files.cell, cal)
         return files.cell, model, cal, lambda: resume_run(args.resume)
     if not args.tour or not args.cell:
@@ -180,6 +215,7 @@ def _prepare(
     tour = load_tour(args.tour)
     check_tour(tour, cell, args.tour)
     cal = _calibration(args, cell, None)
+    args.network = _markers(args, cell, None)
     model = _thermal_model(args.thermal, cell, cal)
     reference = (
         plan_reference_tour(cell, tour=tour)
@@ -249,6 +285,9 @@ def run_run(args: argparse.Namespace) -> int:
         run_dir = files.store.path.parent
         if calibration is not None:
             store_calibration(calibration, run_dir)
+        if args.network is not None and args.markers:
+            write_text_atomic(run_dir / MARKERS_FILENAME,
+                              Path(args.markers).read_text(encoding="utf-8"))  # fmt: skip
         stored = len(files.store.done_ids())
         options = RunOptions(
             settle_s=args.settle_s,
@@ -263,7 +302,8 @@ def run_run(args: argparse.Namespace) -> int:
             recorder = Recorder.create(_rrd_path(run_dir), files.cell, files.tour, args.spawn,
                                        args.connect)  # fmt: skip
         runner = Runner(files.cell, files.tour, files.store, client, camera, options,
-                        files.reference, model, progress, recorder, calibration)  # fmt: skip
+                        files.reference, model, progress, recorder, calibration,
+                        markers=args.network)  # fmt: skip
         try:
             result = runner.run(None if args.yes or not sys.stdin.isatty() else _ask_start)
         except BaseException:

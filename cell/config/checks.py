@@ -63,6 +63,13 @@ def marker_problems(cfg: CellConfig) -> list[Problem]:
 
 def duplicate_ids(cfg: CellConfig) -> list[Problem]:
     problems = []
+    codes: set[int] = set()
+    for i, m in enumerate(cfg.reference_markers):
+        code = i if m.code is None else m.code
+        if code in codes:
+            problems.append((f"reference_markers[{i}].code", code, "duplicate code (the code "
+                             "is the marker's place in the list when not given)"))  # fmt: skip
+        codes.add(code)
     for group, items in (
         ("part.holes", cfg.part.holes),
         ("reference_targets", cfg.reference_targets),

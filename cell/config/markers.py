@@ -5,7 +5,8 @@ adjustment (``holecell survey``) so that every stop can be located against them.
 ``position`` is in the part frame when it is stuck on the part (``on: part``: it moves with the
 part's placement) and in the cell frame when it is on the fixture or the table
 (``on: fixture``). ``normal`` is the unit normal out of the marker's face, ``diameter_m`` the
-white dot's diameter.
+white dot's diameter, ``code`` the number its code ring (or tag) carries (default: the marker's
+place in the list, 0 for the first), which the detector reads to identify it.
 
 ``scale_bars``: two markers a calibrated length apart (``length_m``, with its expanded
 uncertainty ``U_m``, k = 2): the survey's scale.
@@ -30,6 +31,7 @@ class ReferenceMarker(_Strict):
     normal: Vec3
     diameter_m: Annotated[float, Field(gt=0, le=MAX_MARKER_DIAMETER_M)]
     on: Literal["part", "fixture"]
+    code: Annotated[int, Field(ge=0)] | None = None
 
     _unit_normal = field_validator("normal")(lambda cls, v: unit_normal(v))
 
@@ -57,3 +59,8 @@ def marker_in_cell(
     if marker.on == "part":
         return T_cell_part[:3, :3] @ p + T_cell_part[:3, 3], T_cell_part[:3, :3] @ n
     return p, n
+
+
+def marker_codes(markers: list[ReferenceMarker]) -> dict[int, str]:
+    """The code each marker carries (its ``code``, else its place in the list) -> its id."""
+    return {(i if m.code is None else m.code): m.id for i, m in enumerate(markers)}

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from cell.calibration.use import RunCalibration, load_run_calibration
+from cell.camera import cell_stereo
 from cell.config import CellConfig, load_builtin_cell
 from cell.demo.calibrate import (
     DemoCalibration,
@@ -29,8 +30,17 @@ from cell.demo.calibrate import (
     calibrate_demo_cell_images,
     plan_demo_caltour,
 )
+from cell.demo.survey import (
+    DemoSurvey,
+    plan_demo_survey,
+    survey_demo_cell,
+    survey_tour_from_dict,
+)
 from cell.demo.truth_error import DatumError, TruthError, datum_truth_error, truth_error
 from cell.link.client import ControllerClient
+from cell.referencing.network import MarkerNetwork, load_network
+from cell.referencing.survey.tour import SurveyTour
+from cell.referencing.viewpoints import MarkerAwarePlanner
 from cell.review.report import write_report
 from cell.run.reference import plan_reference_tour
 from cell.run.runner import Progress, Runner, RunOptions, RunResult
@@ -44,6 +54,7 @@ from cell.uncertainty.repeatability import repeatability_rp_m
 from planner import Options, Tour, TourPlanner
 from planner.calibration import CalibrationTour, caltour_from_dict
 from planner.tour import tour_from_dict
+from robots.thermal.drift import DriftSettings, WarmUp, default_settings
 
 
 @dataclass(frozen=True)
@@ -79,6 +90,12 @@ class DemoOptions:
             over many seeds, :mod:`cell.demo.calibrate`).
         calibration_speed: simulation speed while the calibration tour is driven (the
             simulated arm warms with the simulated time, whatever the speed).
+        referencing: survey the cell's reference markers on the simulated cell (after the
+            calibration) and locate every stop against them (False: ``--no-referencing``, the
+            holes carried into the part by the arm). Only when the cell has markers.
+        survey_speed: simulation speed while the survey tour is driven.
+        thermal_scale: the arm's warm-up rises multiplied by this (a benchmark's robustness
+            check: 3 is three times the reference warm-up's drift).
         truth: every hidden error of the simulated cell (a truth file, ``--truth``); None:
             the drawn truth above (or, without ``geometry_errors``, no geometric error).
         decision_rule: the run's decision rule.
@@ -100,6 +117,9 @@ class DemoOptions:
     calibration_views: int = 120
     calibration_method: str = "images"
     calibration_speed: float = 5.0
+    referencing: bool = True
+    survey_speed: float = 20.0
+    thermal_scale: float = 1.0
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
     truth: CellTruth | None = None
@@ -121,6 +141,7 @@ class DemoResult:
     timings: dict[str, float]
     datum: DatumError | None = None
     calibration: DemoCalibration | None = None
+    survey: DemoSurvey | None = None
 
 
 def _plan_reference(seed: int) -> dict[str, Any]:
@@ -134,9 +155,11 @@ def plan_demo(
     seed: int,
     plan_progress: Callable[[str, int, int], None] | None = None,
     caltour_views: int = 0,
-) -> tuple[Tour, Tour, CalibrationTour | None]:
-    """The hole tour, the reference tour and (``caltour_views`` > 0) the calibration tour of
-    ``cell``; the other two are planned in worker processes while this one plans the holes.
+    survey: bool = False,
+) -> tuple[Tour, Tour, CalibrationTour | None, SurveyTour | None]:
+    """The hole tour, the reference tour, (``caltour_views`` > 0) the calibration tour and
+    (``survey``) the survey tour of ``cell``; the others are planned in worker processes while
+    this one plans the holes.
     The workers are started by a fork server, not forked from this one: a process that has
     run a simulator or a planner holds threads (and their locks) that a forked child would
     inherit locked."""
@@ -144,10 +167,16 @@ def plan_demo(
     with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
         ref_job = pool.submit(_plan_reference, seed)
         cal_job = pool.submit(plan_demo_caltour, caltour_views, seed) if caltour_views else None
-        tour = TourPlanner(Options(seed=seed), plan_progress).plan(cell)
+        survey_job = pool.submit(plan_demo_survey, seed) if survey else None
+        tour = (
+            MarkerAwarePlanner(cell, cell_stereo(cell), Options(seed=seed), plan_progress)
+            if survey
+            else TourPlanner(Options(seed=seed), plan_progress)
+        ).plan(cell)
         reference = tour_from_dict(ref_job.result(), "reference tour")
         caltour = None if cal_job is None else caltour_from_dict(cal_job.result(), "caltour")
-    return tour, reference, caltour
+        planned = None if survey_job is None else survey_tour_from_dict(survey_job.result())
+    return tour, reference, caltour, planned
 
 
 def run_demo(
@@ -164,8 +193,10 @@ def run_demo(
     t0 = time.perf_counter()
     cell = load_builtin_cell()
     images = opts.calibrate and opts.realistic and opts.calibration_method == "images"
-    tour, reference, caltour = plan_demo(cell, opts.seed, plan_progress,
-                                         opts.calibration_views if images else 0)  # fmt: skip
+    referencing = opts.referencing and bool(cell.reference_markers)
+    tour, reference, caltour, planned = plan_demo(
+        cell, opts.seed, plan_progress, opts.calibration_views if images else 0, referencing
+    )
     t_plan = time.perf_counter() - t0
     # real time until the first reference round starts (its readings are the cold state)
     world = demo_world(cell, opts)
@@ -174,8 +205,9 @@ def run_demo(
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
         try:
             cal, run_cal = _calibration(sim, files, opts, caltour)
+            surveyed, network = _survey(sim, files, opts, planned)
             result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder,
-                              run_cal)  # fmt: skip
+                              run_cal, network)  # fmt: skip
             truth = truth_error(sim.world, files.store.results())
             results = files.store.results()
         finally:
@@ -186,8 +218,21 @@ def run_demo(
     datum = datum_truth_error(sim.world, results, Path(out_dir))
     timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
                "calibration_s": cal.seconds if cal else 0.0,
+               "survey_s": surveyed.seconds if surveyed else 0.0,
                "total_s": time.perf_counter() - t0}  # fmt: skip
-    return DemoResult(Path(out_dir), tour, result, summary, truth, timings, datum, cal)
+    return DemoResult(Path(out_dir), tour, result, summary, truth, timings, datum, cal, surveyed)
+
+
+def _survey(
+    sim: SimCell, files: RunFiles, opts: DemoOptions, planned: SurveyTour | None
+) -> tuple[DemoSurvey | None, MarkerNetwork | None]:
+    """Survey the simulated cell's markers (``planned``: the survey tour, None: no referencing),
+    write ``markers.json`` into the run directory and load it back as the run does (checked)."""
+    if planned is None:
+        return None, None
+    surveyed = survey_demo_cell(sim, files.cell, planned, files.store.path.parent,
+                                opts.survey_speed)  # fmt: skip
+    return surveyed, load_network(surveyed.path, files.cell, sim.camera.stereo)
 
 
 def _calibration(
@@ -213,13 +258,27 @@ def demo_world(cell: CellConfig, opts: DemoOptions) -> WorldOptions:
     readings are the cold state), the truth of :func:`demo_truth`; with ``realistic`` a true
     expansion coefficient off the material's figure, drawn from its stated uncertainty."""
     base = WorldOptions(speed=1.0, drift_offset_s=0.0, truth=demo_truth(cell, opts),
-                        part_thermometer_sigma_K=opts.thermometer_sigma_K)  # fmt: skip
+                        part_thermometer_sigma_K=opts.thermometer_sigma_K,
+                        drift=_scaled_drift(opts.thermal_scale))  # fmt: skip
     if not opts.realistic:
         return base
     material, _ = cell.part_material()
     rng = np.random.default_rng([base.seed, 0xA1FA])
     alpha = material.alpha_per_K + rng.normal(0.0, material.u_alpha_per_K)
     return replace(base, part_alpha_per_K=alpha)
+
+
+def _scaled_drift(k: float) -> DriftSettings | None:
+    """The reference warm-up with every rise multiplied by ``k`` (None: ``k`` = 1, as is)."""
+    if k == 1.0:
+        return None
+    d = default_settings()
+    rise = tuple(WarmUp(k * w.rise_K, w.tau_s) for w in d.link_warmup)
+    return replace(
+        d,
+        link_warmup=rise,
+        sensor_warmup=tuple(WarmUp(k * w.rise_K, w.tau_s) for w in d.sensor_warmup),
+    )
 
 
 def demo_truth(cell: CellConfig, opts: DemoOptions) -> CellTruth:
@@ -265,8 +324,10 @@ def _run_sim(
     progress: Progress,
     recorder: Any,
     calibration: RunCalibration | None = None,
+    network: MarkerNetwork | None = None,
 ) -> RunResult:
-    """Run the stored tour on the simulated cell over its port."""
+    """Run the stored tour on the simulated cell over its port (referenced against
+    ``network`` when given)."""
     run_opts = RunOptions(
         settle_s=0.2 / opts.run_speed,
         reference_rounds=opts.reference_rounds,
@@ -277,5 +338,6 @@ def _run_sim(
     )
     with ControllerClient(sim.url) as client:
         runner = Runner(files.cell, files.tour, files.store, client, sim.camera, run_opts,
-                        files.reference, None, progress, recorder, calibration)  # fmt: skip
+                        files.reference, None, progress, recorder, calibration,
+                        markers=network)  # fmt: skip
         return runner.run()

@@ -8,6 +8,9 @@ each hole, :func:`gdt_extra`). The components are drawn as they act in a run:
 - ``circle_fit``, ``robot_repeatability`` and ``thermal_model``: independently per hole (the
   thermal model's error varies with the pose; taken as independent, which overstates what a
   common part of it does to an alignment);
+- ``resection`` and ``survey_markers`` (a referenced stop): independently per hole (stops that
+  share markers share part of the survey's error; drawn as independent, which overstates it
+  for a datum frame);
 - ``stereo_calibration``: one error of the head for the whole run (the head is off its
   calibration by the same amount at every stop): one standard normal draw per run, mapped into
   each hole's centre through its own covariance in the left camera frame and that stop's
@@ -59,7 +62,7 @@ class McOptions:
     seed: int = 19
 
 
-INDEPENDENT = ("circle_fit", "robot_repeatability", "thermal_model")
+INDEPENDENT = ("circle_fit", "robot_repeatability", "thermal_model", "resection", "survey_markers")
 
 
 def gdt_extra(contributions: list[Any], T_part_left: np.ndarray) -> dict[str, Any]:

@@ -36,6 +36,8 @@ FORMAT = "holecell.markers"
 FORMAT_VERSION = 1
 #: a survey older than this is refused by default (days): markers get knocked, fixtures move
 MAX_AGE_DAYS = 7.0
+#: the copy a referenced run keeps in its run directory
+MARKERS_FILENAME = "markers.json"
 
 
 def cell_fingerprint(cell: CellConfig) -> str:
@@ -127,10 +129,11 @@ def check_markers(
     src: str,
     cell: CellConfig,
     stereo: StereoCalibration,
-    max_age_days: float = MAX_AGE_DAYS,
+    max_age_days: float | None = MAX_AGE_DAYS,
     now: datetime | None = None,
 ) -> None:
-    """Refuse a ``markers.json`` of another cell or marker layout, another head, or too old."""
+    """Refuse a ``markers.json`` of another cell or marker layout, another head, or too old
+    (``max_age_days`` None: any age, the copy a resumed run stored)."""
     prov = doc.get("provenance") or {}
     if prov.get("cell_fingerprint") != cell_fingerprint(cell):
         raise MarkersFileError(
@@ -154,6 +157,8 @@ def check_markers(
             src, "created_utc", f"must be YYYY-MM-DDTHH:MM:SSZ, got {doc.get('created_utc')!r}"
         ) from None
     age = ((now or datetime.now(UTC)) - created).total_seconds() / 86400.0
+    if max_age_days is None:
+        return
     if not math.isfinite(max_age_days) or age > max_age_days:
         raise MarkersFileError(
             src,

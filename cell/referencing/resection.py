@@ -35,7 +35,9 @@ class Resection:
     """The located stop: ``T_cell_left`` (4, 4) and the covariance (6, 6) of ``(w, tau)`` (rad,
     m; ``w`` turns the left camera's own axes, ``tau`` moves its origin); ``used`` and
     ``refused`` (id -> reason) markers; ``rms_px`` the residual RMS; ``ok`` False when fewer
-    than :data:`MIN_MARKERS` markers remain (``reason`` says why)."""
+    than :data:`MIN_MARKERS` markers remain (``reason`` says why). ``covariance_markers``: the
+    part of ``covariance`` that comes from the survey's marker covariance (the rest is the
+    image noise's)."""
 
     ok: bool
     T_cell_left: Array
@@ -44,13 +46,19 @@ class Resection:
     refused: dict[str, str] = field(default_factory=dict)
     rms_px: float = float("nan")
     reason: str = ""
+    covariance_markers: Array | None = None
+
+    def point_jacobian(self, p_left: Array) -> Array:
+        """d p_cell / d (w, tau) (3, 6) of a point ``p_left`` (m) of the left camera frame."""
+        R = self.T_cell_left[:3, :3]
+        return np.hstack([-R @ skew(np.asarray(p_left, float)), np.eye(3)])
 
     def point(self, p_left: Array, cov_left: Array | None = None) -> tuple[Array, Array]:
         """A point measured in the left camera frame, in the cell frame, and its covariance
         (3, 3) m²: the resection's and (when given) the point's own."""
         R, t = self.T_cell_left[:3, :3], self.T_cell_left[:3, 3]
         p_left = np.asarray(p_left, float)
-        J = np.hstack([-R @ skew(p_left), np.eye(3)])  # d p_cell / d (w, tau)
+        J = self.point_jacobian(p_left)
         cov = J @ self.covariance @ J.T
         if cov_left is not None:
             cov = cov + R @ np.asarray(cov_left, float) @ R.T
@@ -135,14 +143,16 @@ def resect(
     J = sol.jac
     JtJ_inv = np.linalg.inv(J.T @ J)
     cov = JtJ_inv.copy()
+    cov_markers = np.zeros((6, 6))
     if covariance is not None:
         Jm = _marker_jacobian(sol.x, args)
         cols = np.unique(obs.marker)
         idx = (3 * cols[:, None] + np.arange(3)).ravel()
         A = JtJ_inv @ J.T @ Jm[:, idx]
-        cov = cov + A @ covariance[np.ix_(idx, idx)] @ A.T
+        cov_markers = A @ covariance[np.ix_(idx, idx)] @ A.T
+        cov = cov + cov_markers
     rms = float(np.sqrt(np.mean((r * sigma_px) ** 2)))
-    return Resection(True, T, cov, tuple(used), refused, rms)
+    return Resection(True, T, cov, tuple(used), refused, rms, "", cov_markers)
 
 
 def _marker_jacobian(x: Array, args: tuple) -> Array:

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.config import CellConfig
-from cell.config.markers import marker_in_cell
+from cell.config.markers import marker_codes, marker_in_cell
 from cell.referencing.observations import MarkerView, T_left_right, project
 from cell.referencing.visibility import seen_each
 from measure import StereoCalibration
@@ -35,12 +35,19 @@ class MarkerTruth:
     normals: Array
     on_fixture: NDArray[np.bool_]
     bar_lengths_m: tuple[float, ...]
+    diameters_m: tuple[float, ...] = ()
+    codes: tuple[int, ...] = ()
 
 
 def draw_marker_truth(
-    cell: CellConfig, seed: int, position_sigma_m: float = 3e-4, T_fixture_part: Array | None = None
+    cell: CellConfig,
+    seed: int,
+    position_sigma_m: float = 3e-4,
+    T_fixture_part: Array | None = None,
+    errors: dict[str, tuple[float, float, float]] | None = None,
 ) -> MarkerTruth:
-    """Each marker off its nominal by N(0, ``position_sigma_m``) per axis; the part's markers
+    """Each marker off its nominal by N(0, ``position_sigma_m``) per axis, or by its offset in
+    ``errors`` (m; part frame for a marker on the part, else cell frame); the part's markers
     also moved by the part's placement ``T_fixture_part`` (part frame, identity: none); each
     scale bar's true length off its calibrated ``length_m`` by N(0, U/2), its ``to`` marker
     placed at that distance from its ``from`` marker (the bar carries both)."""
@@ -51,6 +58,8 @@ def draw_marker_truth(
     for m in cell.reference_markers:
         p, n = marker_in_cell(m, T_cell_part)
         e = rng.normal(0.0, position_sigma_m, 3)
+        if errors and m.id in errors:
+            e = np.asarray(errors[m.id], float)
         if m.on == "part":
             q = np.asarray(m.position, float) + e
             T = T_cell_part @ T_place
@@ -70,9 +79,11 @@ def draw_marker_truth(
         d = true_arr[j] - true_arr[i]
         true_arr[j] = true_arr[i] + d / np.linalg.norm(d) * length
         bars.append(length)
+    codes = {mid: code for code, mid in marker_codes(cell.reference_markers).items()}
     return MarkerTruth(
-        ids, np.array(nominal), true_arr, np.array(normals), np.array(fixture), tuple(bars)
-    )
+        ids, np.array(nominal), true_arr, np.array(normals), np.array(fixture), tuple(bars),
+        tuple(float(m.diameter_m) for m in cell.reference_markers), tuple(codes[i] for i in ids),
+    )  # fmt: skip
 
 
 def observe(

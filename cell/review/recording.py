@@ -14,6 +14,10 @@ attached to the scene root by ``T_cell_base``):
   with its edge points (filled ones in orange) and fitted ellipse drawn over it.
 - ``plots/deviation/*`` (um), ``plots/temperature/*`` (degC): time series; ``run/state``: the
   run state as a state timeline.
+- ``referencing/markers``: the surveyed markers (static, labelled by id); at each referenced
+  stop ``run/head/resected`` and ``run/head/arm`` (the left camera where the markers and where
+  the arm put it), ``run/head/markers`` (the markers the stop used) and
+  ``plots/referencing/arm_disagreement`` (um).
 - ``plots/uncertainty/U_position|U_diameter`` (um, k = 2) and ``plots/budget/<component>`` (the
   position's standard uncertainty per component, um): time series; ``run/decision``: the ISO
   14253-1 decision of each hole as a log line; ``run/decisions/<hole>``: the hole coloured by
@@ -191,9 +195,34 @@ class Recorder:
         """The run state changed."""
         self.rec.log("run/state", rr.StateChange(state=state))
 
-    def hole(self, result: HoleResult, meas, pair, status, T_cell_left: np.ndarray) -> None:
+    def markers(self, ids: tuple[str, ...], positions_cell: np.ndarray) -> None:
+        """The surveyed marker network (static)."""
+        self._marker_ids = {m: k for k, m in enumerate(ids)}
+        self._marker_pos = self._p(np.asarray(positions_cell, float))
+        self.rec.log("referencing/markers", rr.Points3D(self._marker_pos, radii=0.003,
+                     colors=[255, 255, 255], labels=list(ids)), static=True)  # fmt: skip
+
+    def _located(self, located) -> None:
+        """A stop's resected head beside the arm's, the markers it used, their difference."""
+        rec, r = self.rec, located.resection
+        if not located.referenced:
+            rec.log("run/event", rr.TextLog(f"{located.view.view_id}: not referenced "
+                                            f"({r.reason})", level="WARN"))  # fmt: skip
+            return
+        for name, T, color in (("resected", r.T_cell_left, [0, 200, 255]),
+                               ("arm", located.T_cell_left_arm, [255, 160, 0])):  # fmt: skip
+            rec.log(f"run/head/{name}", rr.Points3D(self._p(T[:3, 3]), radii=0.004,
+                                                    colors=[color]))  # fmt: skip
+        rec.log("plots/referencing/arm_disagreement", rr.Scalars(located.disagreement_m * 1e6))
+        idx = [self._marker_ids[m] for m in r.used if m in getattr(self, "_marker_ids", {})]
+        if idx:
+            rec.log("run/head/markers", rr.Points3D(self._marker_pos[idx], radii=0.004,
+                                                    colors=[0, 255, 120]))  # fmt: skip
+
+    def hole(self, result: HoleResult, meas, pair, status, T_cell_left: np.ndarray,
+             located=None) -> None:  # fmt: skip
         """Log one stop: joints, temperatures, images with edges and ellipse, 3D points,
-        circle, deviations."""
+        circle, deviations; ``located``: the stop's referencing, if the run is referenced."""
         rec = self.rec
         rec.set_time("run_time", duration=float(status.time_s))
         self._joints(status.q_rad)
@@ -201,6 +230,8 @@ class Recorder:
         rec.log("run/tcp", rr.Points3D(tcp, radii=0.005, colors=[0, 220, 0]))
         for i, t in enumerate(status.temperatures_c):
             rec.log(f"plots/temperature/s{i + 1}", rr.Scalars(float(t)))
+        if located is not None:
+            self._located(located)
         if meas is None:
             rec.log("run/event", rr.TextLog(f"{result.hole_id}: {result.reason}", level="WARN"))
             return

@@ -7,7 +7,9 @@ pass, u_center_m, u_diameter_m, reason, thermal_model_id, axial_deviation_m, U_p
 U_diameter_m, decision, decision_rule`` and one ``u_<component>_position_m`` /
 ``u_<component>_diameter_m`` pair per budget component (empty cells where a hole was not
 measured; ``thermal_model_id``: the row of the store's ``thermal_models`` the hole was
-compensated with, empty for the nominal kinematics).
+compensated with, empty for the nominal kinematics; ``referenced``: the stop was located
+against the surveyed markers (True), fell back to the arm (False), or the run was not
+referenced (empty); ``reference_markers``: the markers the stop was located by, space-separated).
 ``u_center_m`` / ``u_diameter_m`` are the circle fit's own one-sigma uncertainties (kept for
 compatibility); ``U_*`` the expanded (k = 2) uncertainties of the whole budget
 (:mod:`cell.uncertainty.budget`); positions and diameters are at 20 degC.
@@ -23,8 +25,10 @@ from typing import Any
 from cell.calibration.use import calibration_summary
 from cell.gdt.report_fields import report_evaluation
 from cell.records.hole_result import HoleResult
+from cell.referencing.markersfile import MARKERS_FILENAME
 from cell.review.gdt_html import gdt_section
 from cell.review.qif.run_file import write_run_qif
+from cell.review.referencing_html import referencing_section
 from cell.review.report_html import render_html
 from cell.review.store import Store
 from cell.uncertainty.budget import COMPONENTS
@@ -38,6 +42,7 @@ CSV_COLUMNS = (
     "position_deviation_m", "nominal_diameter_m", "diameter_m", "diameter_deviation_m",
     "tolerance_m", "pass", "u_center_m", "u_diameter_m", "reason", "thermal_model_id",
     "axial_deviation_m", "U_position_m", "U_diameter_m", "decision", "decision_rule",
+    "referenced", "reference_markers",
     *(f"u_{c}_{q}_m" for c in COMPONENTS for q in ("position", "diameter")),
 )  # fmt: skip
 
@@ -67,6 +72,7 @@ def summary(store: Store) -> dict[str, Any]:
         "holes_nonconforming": sum(r.decision == NONCONFORMING for r in results),
         "decision_rule": next((r.decision_rule for r in results if r.decision_rule), None),
         "part": store.part_state(),
+        **_referencing_counts(results),
         "calibration": calibration_summary(store.path.parent),
         "max_U_position_m": max(
             (r.U_position_m for r in measured if r.U_position_m is not None), default=None
@@ -82,6 +88,19 @@ def summary(store: Store) -> dict[str, Any]:
         "started_at": info["started_at"],
         "finished_at": info["finished_at"],
     }
+
+
+def _referencing_counts(results: list[HoleResult]) -> dict[str, Any]:
+    """How many stops were located against the markers, fell back to the arm, or were flagged
+    (the arm and the markers disagree by more than 1 mm); None when the run was not
+    referenced."""
+    refs = [r.extra["referencing"] for r in results if "referencing" in r.extra]
+    if not refs:
+        return {"holes_referenced": None, "holes_fallback": None, "holes_arm_disagreement": None}
+    return {"holes_referenced": sum(bool(x.get("referenced")) for x in refs),
+            "holes_fallback": sum(not x.get("referenced") for x in refs),
+            "holes_arm_disagreement": sum(x.get("arm_disagreement_m", 0.0) > 1e-3
+                                          for x in refs)}  # fmt: skip
 
 
 def _row(r: HoleResult) -> dict[str, Any]:
@@ -108,8 +127,18 @@ def _row(r: HoleResult) -> dict[str, Any]:
         "U_diameter_m": r.U_diameter_m,
         "decision": r.decision,
         "decision_rule": r.decision_rule,
+        **_referencing(r),
         **_components(r),
     }  # fmt: skip
+
+
+def _referencing(r: HoleResult) -> dict[str, Any]:
+    """Whether the stop was located against the markers, and by which."""
+    ref = r.extra.get("referencing")
+    if ref is None:
+        return {"referenced": None, "reference_markers": None}
+    return {"referenced": bool(ref.get("referenced")),
+            "reference_markers": " ".join(ref.get("markers", [])) or None}  # fmt: skip
 
 
 def _components(r: HoleResult) -> dict[str, Any]:
@@ -138,7 +167,8 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
         reference = [(o[0], o[3]) for o in store.reference_observations()]
     gdt, results = report_evaluation(info, results, rows, summ)  # cell.gdt, docs/gdt.md
     html = render_html(summ, info, results, planned, operator, reference,
-                       gdt_section(gdt.fields()), gdt.alignment == "fixture")  # fmt: skip
+                       gdt_section(gdt.fields()), gdt.alignment == "fixture",
+                       referencing_section(results, _markers_doc(run_dir)))  # fmt: skip
     write_text_atomic(run_dir / "report.html", html)
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events, **gdt.fields()}  # fmt: skip
@@ -150,6 +180,17 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
             w.writerow({k: ("" if v is None else v) for k, v in row.items()})
     write_run_qif(doc, run_dir, info, results)  # QIF 3.0 results (cell.review.qif)
     return summ
+
+
+def _markers_doc(run_dir: Path) -> dict[str, Any] | None:
+    """The run's copy of ``markers.json`` (a referenced run), or None."""
+    path = run_dir / MARKERS_FILENAME
+    if not path.exists():
+        return None
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
 
 
 def format_summary(summ: dict[str, Any]) -> str:
@@ -175,6 +216,10 @@ def format_summary(summ: dict[str, Any]) -> str:
                      f"{chars['inconclusive']} inconclusive, {chars['nonconformance']} "
                      f"nonconformance proven, {chars['not_evaluated']} not evaluated "
                      f"(alignment {summ['alignment']})")  # fmt: skip
+    if summ.get("holes_referenced") is not None:
+        lines.append(f"referencing     {summ['holes_referenced']} located against the markers, "
+                     f"{summ['holes_fallback']} fell back to the arm, "
+                     f"{summ['holes_arm_disagreement']} off the arm by over 1 mm")  # fmt: skip
     part = summ.get("part")
     if part:
         lines.append(f"part            {part['temperature_c']:.2f} degC "

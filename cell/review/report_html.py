@@ -249,12 +249,14 @@ def _budget_table(results: list[HoleResult]) -> str:
 def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleResult],
                 planned: list[tuple[str, int, dict]], operator: str = "",
                 reference: list[tuple[float, Any]] | None = None,
-                gdt_html: str = "", fixture_plot: bool = True) -> str:  # fmt: skip
+                gdt_html: str = "", fixture_plot: bool = True,
+                referencing_html: str = "") -> str:  # fmt: skip
     """The whole ``report.html`` document; ``reference``: (controller time s, readings degC)
     of the reference-target observations, for the thermal plot; ``gdt_html``: the alignment
     and characteristics (:mod:`cell.review.gdt_html`), after the counts; ``fixture_plot``: draw the
     deviation vectors in the part frame (False when the run is evaluated in a datum frame,
-    whose own plot ``gdt_html`` holds)."""
+    whose own plot ``gdt_html`` holds); ``referencing_html``: the marker network and each
+    stop's referencing (:mod:`cell.review.referencing_html`), after the budget."""
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>Inspection report {escape(summ['cell'])}</title><style>{CSS}</style></head><body>",
@@ -274,6 +276,7 @@ def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleRe
         _bar_plot(results, "diameter_deviation_m", "U_diameter_m", "|diameter deviation|"),
         "<h2>Thermal drift over the run</h2>", _thermal_plot(results, reference or []),
         "<h2>Uncertainty budget (standard uncertainties, GUM)</h2>", _budget_table(results),
+        referencing_html,
         f"<p class='note'>written {_date(time.time())} by holecell</p></body></html>",
     ]  # fmt: skip
     return "\n".join(parts)

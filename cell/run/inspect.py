@@ -22,6 +22,7 @@ from cell.calibration.use import RunGeometry
 from cell.config import CellConfig, HoleInCell
 from cell.gdt.montecarlo import gdt_extra
 from cell.records.hole_result import HoleResult, deviations
+from cell.run.referenced import LocatedStop, referenced_contributions
 from cell.uncertainty.budget import combine
 from cell.uncertainty.context import BudgetContext, budget_context, hole_contributions
 from cell.uncertainty.decision import decide_hole, decide_one
@@ -58,13 +59,20 @@ def inspect_hole(
     temps_c: np.ndarray,
     sim_time_s: float,
     context: BudgetContext | None = None,
+    located: LocatedStop | None = None,
+    network_source: str = "",
+    exclude: tuple[list, list] | None = None,
 ) -> tuple[HoleResult, HoleMeasurement | None]:
     """Measure ``hole`` from one pair and compare it with its nominal; never raises for a hole
     that is not there (``missing``) or cannot be measured (``unmeasured``: a resume retries
     it). ``context``: the run's budget inputs (default: the cell's, part temperature from the
     cell file or assumed, ISO 14253-1 rule). ``arm``: the kinematics the measurement is carried
     through (a :class:`RunGeometry` with a calibration adds its ``cell_calibration`` budget
-    row)."""
+    row). ``located``: the stop located against the surveyed markers (a referenced run): when
+    it is referenced the hole is carried into the cell by the resected pose and its budget has
+    the resection's and the survey's rows in place of the arm's (:mod:`cell.run.referenced`);
+    either way ``extra["referencing"]`` says what happened. ``exclude``: per image, circles
+    around the markers' labels, never taken for the hole (:func:`measure.measure_hole`)."""
     T_part_cell = invert(cell.T_cell_part())
     nominal = T_part_cell[:3, :3] @ hole.position_m + T_part_cell[:3, 3]
     base = _base_fields(hole, stop_index, nominal, q_rad, temps_c, sim_time_s)
@@ -76,6 +84,7 @@ def inspect_hole(
             stereo,
             expected_diameter_m=hole.diameter_m,
             expected_standoff_m=cell.tool.standoff_m,
+            exclude=exclude,
         )
     except HoleNotFoundError as exc:
         return HoleResult(status="missing", reason=f"no hole found: {exc}", **base), None
@@ -84,19 +93,30 @@ def inspect_hole(
     t_meas = time.perf_counter() - t0
     ctx = context or budget_context(cell, stereo)
     T_head_left = invert(head_frame(stereo))
-    T_part_left = T_part_cell @ T_cell_tcp(arm, model, q_rad, temps_c) @ T_head_left
+    referenced = located is not None and located.referenced
+    T_cell_left = (located.resection.T_cell_left if referenced
+                   else T_cell_tcp(arm, model, q_rad, temps_c) @ T_head_left)  # fmt: skip
+    T_part_left = T_part_cell @ T_cell_left
     T_nom = T_part_cell @ arm.fk(q_rad, "tcp") @ T_head_left
     center_nominal_fk = ctx.part.to_20c(T_nom[:3, :3] @ meas.center_m + T_nom[:3, 3])
     extra = {"center_part_uncompensated_m": [float(v) for v in center_nominal_fk]}
+    if located is not None:
+        extra["referencing"] = located.to_dict()
     normal_part = T_part_cell[:3, :3] @ hole.normal
     result = _measured(meas, T_part_left, hole, nominal, t_meas, extra, base, ctx, normal_part)
     center_tcp = T_head_left[:3, :3] @ meas.center_m + T_head_left[:3, 3]
-    cal_A, cal_note = _calibration_factor(arm, q_rad, meas.center_m, T_part_cell[:3, :3])
+    cal_A, cal_note = (None, "") if referenced else _calibration_factor(
+        arm, q_rad, meas.center_m, T_part_cell[:3, :3])  # fmt: skip
     cal_cov = None if cal_A is None else cal_A @ cal_A.T
     contributions = hole_contributions(
         ctx, stereo, meas, T_part_left[:3, :3], T_part_cell[:3, :3], model, arm.T_cell_base,
         arm.T_tool0_tcp, q_rad, temps_c, center_tcp, np.array(result.center_part_m),
         result.diameter_m, cal_cov, cal_note)  # fmt: skip
+    if referenced:
+        rows = {c.name: c for c in contributions}
+        contributions = referenced_contributions(
+            located, meas.center_m, T_part_cell[:3, :3], rows["circle_fit"],
+            rows["stereo_calibration"], rows["part_temperature"], network_source)  # fmt: skip
     delta = np.array(result.center_part_m) - nominal
     budget = combine(contributions, delta, normal_part, (ctx.part.note(),))
     extra = {**result.extra, **gdt_extra(contributions, T_part_left)}

@@ -22,14 +22,18 @@ import numpy as np
 from cell.calibration.use import RunCalibration, RunGeometry, calibrated_stereo, correct_tour
 from cell.camera import CameraBackend
 from cell.config import CellConfig
+from cell.config.markers import marker_codes
 from cell.errors import CellError
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError, RunFaultError
 from cell.link.motion import Motion
 from cell.records.hole_result import HoleResult
+from cell.referencing.detection import detect_pair, label_circles
+from cell.referencing.network import MarkerNetwork
 from cell.review.store import Store
 from cell.run.inspect import T_cell_tcp, inspect_hole
 from cell.run.reference import target_of
+from cell.run.referenced import ARM_DISAGREEMENT_M, LocatedStop, locate_stop
 from cell.run.thermal_record import remember_model, stored_model, stored_rows
 from cell.run.thermal_update import ThermalUpdate
 from cell.uncertainty.context import BudgetContext, budget_context
@@ -115,6 +119,7 @@ class Runner(Motion):
         recorder=None,
         calibration: RunCalibration | None = None,
         base_from: str = "cell",
+        markers: MarkerNetwork | None = None,
     ) -> None:
         self.cell, self.tour, self.store, self.client, self.camera = (
             cell,
@@ -130,8 +135,12 @@ class Runner(Motion):
         self.recorder = recorder
         self.arm = cell.build_arm()
         target = cell.calibration_target
-        # the head as triangulated: the stereo file, with the calibration's extrinsics if any
-        self.stereo = calibrated_stereo(camera.stereo, calibration)
+        # the head as triangulated: the stereo file, with the calibration's extrinsics if any;
+        # a referenced run measures with the head as the survey self-calibrated it
+        self.markers = markers
+        self.codes = marker_codes(cell.reference_markers)
+        self.stereo = (markers.head if markers is not None
+                       else calibrated_stereo(camera.stereo, calibration))  # fmt: skip
         self.geometry = RunGeometry(self.arm, self.stereo, calibration,
                                     None if target is None else target.T_cell_target(),
                                     base_from)  # fmt: skip
@@ -170,6 +179,7 @@ class Runner(Motion):
     def _run(self, result: RunResult, wait_for_start: Callable[[], None] | None) -> None:
         stored = self.store.done_ids()
         self._note_calibration()
+        self._note_referencing()
         self._restore_thermal()
         self._state("waiting", holes=len(self.tour.stops), stored=len(stored))
         if wait_for_start is not None:
@@ -236,6 +246,18 @@ class Runner(Motion):
             "the planned pose)",
         )
 
+    def _note_referencing(self) -> None:
+        if self.markers is None:
+            self.store.event("referencing", "not referenced: every hole is carried into the "
+                             "part by the arm's kinematics")  # fmt: skip
+        else:
+            m = self.markers
+            self.store.event("referencing", f"referenced against {len(m.ids)} surveyed markers "
+                             f"({m.source}); the head as the survey self-calibrated "
+                             "it")  # fmt: skip
+            if self.recorder is not None:
+                self.recorder.markers(m.ids, m.positions_cell)
+
     # --- thermal state in the store --------------------------------------------------------
     def _restore_thermal(self) -> None:
         """Reload the stored reference observations; use the given model (stored if new) or
@@ -297,8 +319,12 @@ class Runner(Motion):
                 self._move(k, f"reference {s.hole_id}")
                 st = self._settled_status()
                 pair = self.camera.capture()
+                exclude = None
+                if self.codes:  # the markers' labels are not the reference target
+                    dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
+                    exclude = label_circles(dets)
                 try:
-                    meas = measure_hole(pair.left, pair.right, self.stereo)
+                    meas = measure_hole(pair.left, pair.right, self.stereo, exclude=exclude)
                 except MeasurementError as exc:
                     self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
                     continue
@@ -335,6 +361,12 @@ class Runner(Motion):
         self.store.event("thermal", msg)
         return msg
 
+    def _note_located(self, hole_id: str, located: LocatedStop) -> None:
+        note = _located_note(hole_id, located)
+        if note is not None:
+            self.store.event(*note)
+            log.warning("%s", note[1])
+
     # --- one hole --------------------------------------------------------------------------
     def _inspect_stop(self, k: int) -> tuple[HoleResult, dict[str, float]]:
         """Move, settle, capture, measure, compensate, compare, store, record one stop; returns
@@ -347,20 +379,49 @@ class Runner(Motion):
         clock.lap("settle_s")
         pair = self.camera.capture()
         clock.lap("capture_s")
+        T_arm = (T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
+                 @ self._T_head_left)  # the arm's idea of the left camera  # fmt: skip
+        located, exclude = None, None
+        if self.codes:  # markers in the cell: found, so that no label is taken for the hole
+            dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
+            exclude = label_circles(dets)
+            if self.markers is not None:
+                located = locate_stop(self.markers, dets, T_arm, stop.hole_id)
+                self._note_located(stop.hole_id, located)
+        clock.lap("locate_s")
         result, meas = inspect_hole(self.cell, self.geometry, self.model, self.stereo,
                                self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
-                               st.temperatures_c, st.time_s, self.budget)  # fmt: skip
+                               st.temperatures_c, st.time_s, self.budget, located,
+                               "" if self.markers is None else self.markers.source,
+                               exclude)  # fmt: skip
         result = replace(result, thermal_model_id=self.model_id if self.model else None)
         clock.lap("inspect_s")
         self.store.record_hole(result)
         clock.lap("store_s")
         if self.recorder is not None:
-            T = T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
-            self.recorder.hole(result, meas, pair, st, T @ self._T_head_left)
+            T = located.resection.T_cell_left if located and located.referenced else T_arm
+            self.recorder.hole(result, meas, pair, st, T, located)
         clock.lap("record_s")
         self.progress("hole", {"stop": k, "result": result})
         clock.laps["measure_s"] = result.measure_time_s
         return result, clock.laps
+
+
+def _located_note(hole_id: str, located: LocatedStop) -> tuple[str, str] | None:
+    """The run-log event of a stop's referencing when there is something to say."""
+    r = located.resection
+    if not located.referenced:
+        return "referencing", (f"{hole_id}: not referenced ({r.reason}): carried into the part by "
+                               "the arm, with the arm's budget")  # fmt: skip
+    if r.refused:
+        refused = "; ".join(f"{m}: {why}" for m, why in r.refused.items())
+        return "referencing", f"{hole_id}: marker(s) refused: {refused}"
+    if located.flagged:
+        return "fault", (f"{hole_id}: the markers place the head {located.disagreement_m * 1e3:.2f}"
+                         f" mm from where the arm says it is (over "
+                         f"{ARM_DISAGREEMENT_M * 1e3:g} mm): a bumped fixture, moved markers "
+                         "or a wrong calibration?")  # fmt: skip
+    return None
 
 
 class _Laps:

@@ -6,7 +6,10 @@ computes the TRUE camera pose (true base, D-H errors and thermal drift, true hea
 front of the head, and renders the pair with :func:`measure.synth.render_hole_pair` (a reference
 target with :func:`measure.synth.render_reference_pair`). A missing hole renders the bare surface.
 With no hole in view and the view axis on the calibration plate (at its true pose), it renders
-the plate with :func:`measure.synth.targets.render_target_pair`.
+the plate with :func:`measure.synth.targets.render_target_pair`. The reference markers in
+front of the head (at their true places, :attr:`cell.sim.world.SimWorld.markers`) are drawn into
+hole scenes and reference scenes; a view with markers and no hole (a survey view) renders them
+with :func:`measure.synth.markers.render_markers_pair`. The part does not hide a marker.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from cell.uncertainty.calibration import (
 from cell.uncertainty.repeatability import sigma_per_axis_m
 from measure import StereoCalibration
 from measure.synth import RenderOptions, render_hole_pair, render_reference_pair
+from measure.synth.markers import MarkerPatch, render_markers_pair
 from measure.synth.targets import render_target_pair
 from robots.transforms import invert
 
@@ -111,9 +115,13 @@ class SimCamera:
         self.captures += 1
         if kind == "target":
             return self._target_pair(T_cell_left, seed)
+        markers = self._marker_patches(T_left_cell)
         if feature is None:  # bare surface facing the head, no hole anywhere near the view
-            pair = render_hole_pair(self.true_stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
             self.last_truth = CaptureTruth(None, "none", T_cell_left, None, None)
+            if markers:
+                pair = render_markers_pair(self.true_stereo, markers, self.render, seed)
+            else:
+                pair = render_hole_pair(self.true_stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
             return StereoPair(pair.left, pair.right)
         c = T_left_cell[:3, :3] @ feature.position_m + T_left_cell[:3, 3]
         n = T_left_cell[:3, :3] @ feature.normal
@@ -121,11 +129,25 @@ class SimCamera:
             u = np.cross(n, [1.0, 0.0, 0.0])
             c = c + 5.0 * u / np.linalg.norm(u)
         fn = render_reference_pair if kind == "reference" else render_hole_pair
-        pair = fn(self.true_stereo, c, n, feature.diameter_m, self.render, seed)
+        pair = fn(self.true_stereo, c, n, feature.diameter_m, self.render, seed, markers=markers)
         self.last_truth = CaptureTruth(
             feature.id, kind, T_cell_left, feature.position_m.copy(), feature.diameter_m
         )
         return StereoPair(pair.left, pair.right)
+
+    def _marker_patches(self, T_left_cell: np.ndarray) -> list[MarkerPatch]:
+        """The true markers facing the head and projecting into (or near) either image, in the
+        left camera frame."""
+        mt = self.world.markers
+        if mt is None:
+            return []
+        R, t = T_left_cell[:3, :3], T_left_cell[:3, 3]
+        p_left = mt.true @ R.T + t
+        n_left = mt.normals @ R.T
+        out = []
+        for k in np.flatnonzero(_in_either_image(self.true_stereo, p_left, n_left)):
+            out.append(MarkerPatch(int(mt.codes[k]), p_left[k], n_left[k], mt.diameters_m[k]))
+        return out
 
     def _target_distance(self, T_cell_tcp: np.ndarray) -> float | None:
         """How far along the head's view axis it meets the calibration plate's printed face
@@ -169,6 +191,27 @@ class SimCamera:
 
     def close(self) -> None:
         """Nothing to release."""
+
+
+#: a marker is drawn when seen this close to face-on (rad) by the left camera
+MARKER_RENDER_ANGLE_RAD = np.radians(80.0)
+
+
+def _in_either_image(stereo: StereoCalibration, p_left: np.ndarray, n_left: np.ndarray):
+    """Mask (n,) of markers (left camera frame) in front of the head, facing it, whose
+    pinhole image lies in (or within 5 % of) the left or the right image."""
+    w, h = stereo.image_size
+    ok = p_left[:, 2] > 0.05
+    to_cam = -p_left / np.maximum(np.linalg.norm(p_left, axis=1, keepdims=True), 1e-12)
+    ok &= np.einsum("ij,ij->i", to_cam, n_left) >= np.cos(MARKER_RENDER_ANGLE_RAD)
+    R, T = np.asarray(stereo.R, float), np.asarray(stereo.T, float).ravel()
+    inside = np.zeros(len(p_left), bool)
+    for K, P in ((stereo.K_left, p_left), (stereo.K_right, p_left @ R.T + T)):
+        z = np.maximum(P[:, 2], 1e-9)
+        uv = (P[:, :2] / z[:, None]) @ np.asarray(K)[:2, :2].T + np.asarray(K)[:2, 2]
+        inside |= ((uv[:, 0] > -0.05 * w) & (uv[:, 0] < 1.05 * w) & (uv[:, 1] > -0.05 * h)
+                   & (uv[:, 1] < 1.05 * h) & (P[:, 2] > 0.05))  # fmt: skip
+    return ok & inside
 
 
 def _depth(T_cell_head: np.ndarray, feature: TrueHole) -> float:

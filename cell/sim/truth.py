@@ -13,6 +13,9 @@ A truth fixes every error the simulated cell has and the runner never sees:
   by the world from ``seed``);
 - ``repeatability_rp_m``: the arm's ISO 9283 RP; ``calibration_sigma_scale``: how far the true
   stereo head is off its calibration file, in its stated sigmas; ``part_temperature_c``;
+- ``marker_position_sigma_m``, ``marker_errors``: each reference marker off its nominal by a
+  seeded N(0, sigma) per axis, or by its given offset (m; markers on the part move with the
+  part's placement); each scale bar's true length off its ``length_m`` by N(0, U/2);
 - ``seed``: every draw of the world (part, noise, head) and of the left-out fields.
 
 **The realistic draw** (:meth:`CellTruth.drawn`, and every field a truth file leaves out)
@@ -27,6 +30,7 @@ depends on the seed only. Each signed error is ``sign * U(lo, hi)`` with a fair 
 | ``part_placement_error`` | ``0.3 mm * U(0.5, 1.5)``, ``0.05 deg * U(0.5, 1.5)`` |
 | ``target_placement_error`` | ``1 mm * U(0.5, 1.5)``, ``0.3 deg * U(0.5, 1.5)`` |
 | ``hole_position_sigma_m``, ``hole_diameter_sigma_m`` | 15 um, 5 um (fixed) |
+| ``marker_position_sigma_m`` | 0.3 mm (fixed): markers stuck on by hand |
 | ``repeatability_rp_m`` | the data-sheet RP of the cell's robot (fixed) |
 | ``calibration_sigma_scale`` | 1 (fixed) |
 | ``part_temperature_c`` | ``U(20, 26) degC`` |
@@ -39,7 +43,7 @@ world before truth files existed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -67,6 +71,7 @@ DH_ANGLE_RANGE_RAD = (np.radians(0.01), np.radians(0.03))
 PART_TEMPERATURE_DRAW_C = (20.0, 26.0)
 HOLE_POSITION_SIGMA_M = 15e-6
 HOLE_DIAMETER_SIGMA_M = 5e-6
+MARKER_POSITION_SIGMA_M = 3e-4
 _STREAM = {
     "dh": 1,
     "base_error": 2,
@@ -100,6 +105,8 @@ class CellTruth:
     repeatability_rp_m: float
     calibration_sigma_scale: float
     part_temperature_c: float
+    marker_position_sigma_m: float = MARKER_POSITION_SIGMA_M
+    marker_errors: dict[str, tuple[float, float, float]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         """Shapes and finiteness checked; the arrays are copied read-only."""
@@ -212,6 +219,10 @@ class CellTruth:
             },
             "calibration_target": {"placement_error": _pose_dict(self.target_placement_error)},
             "stereo": {"calibration_sigma_scale": float(self.calibration_sigma_scale)},
+            "reference_markers": {
+                "position_error_sigma_m": float(self.marker_position_sigma_m),
+                "errors": {k: [float(v) for v in e] for k, e in self.marker_errors.items()},
+            },
         }
 
     def to_yaml(self) -> str:
@@ -243,6 +254,17 @@ def from_spec(spec: TruthSpec, cell: CellConfig | None = None, seed: int = 0) ->
         "calibration_sigma_scale": spec.stereo.calibration_sigma_scale,
     }
     given |= {k: float(v) for k, v in scalars.items() if v is not None}
+    rm = spec.reference_markers
+    if rm.position_error_sigma_m is not None:
+        given["marker_position_sigma_m"] = float(rm.position_error_sigma_m)
+    if rm.errors and cell is not None:
+        known = {m.id for m in cell.reference_markers}
+        bad = [(f"reference_markers.errors.{k}", k, "names no reference marker of the cell")
+               for k in rm.errors if k not in known]  # fmt: skip
+        if bad:
+            raise TruthFileError("truth file", bad)
+    if rm.errors:
+        given["marker_errors"] = {k: tuple(float(x) for x in v) for k, v in rm.errors.items()}
     return replace(base, dh_errors=dh, **given)
 
 

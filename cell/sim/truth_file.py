@@ -99,6 +99,11 @@ class StereoTruth(_Strict):
     calibration_sigma_scale: Annotated[float, Field(ge=0, le=10)] | None = None
 
 
+class MarkersTruth(_Strict):
+    position_error_sigma_m: Sigma | None = None
+    errors: dict[str, Annotated[list[float], Field(min_length=3, max_length=3)]] = {}
+
+
 class TruthSpec(_Strict):
     """A whole truth file (every key optional)."""
 
@@ -110,6 +115,7 @@ class TruthSpec(_Strict):
     part: PartTruth = PartTruth()
     calibration_target: TargetTruth = TargetTruth()
     stereo: StereoTruth = StereoTruth()
+    reference_markers: MarkersTruth = MarkersTruth()
 
 
 class _Short(str):

@@ -12,11 +12,12 @@ import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from cell.camera import cell_stereo
+from cell.referencing.synthetic import MarkerTruth, draw_marker_truth
 from cell.sim.true_geometry import TrueGeometry
 from cell.sim.truth import CellTruth
 from measure import StereoCalibration, head_frame
@@ -136,6 +137,7 @@ class SimWorld:
         self.part_alpha_per_K = (cell.part_material()[0].alpha_per_K
                                  if o.part_alpha_per_K is None else o.part_alpha_per_K)  # fmt: skip
         self.holes_at_temperature = self._expanded(self.holes)
+        self.markers = self._true_markers()
 
     def true_geometry(self, stereo: StereoCalibration | None = None) -> TrueGeometry:
         """The true frames (for the simulated head and benchmarks; never for the runner);
@@ -155,6 +157,21 @@ class SimWorld:
             p_part = T[:3, :3].T @ (h.position_m - T[:3, 3])
             out[k] = TrueHole(h.id, T[:3, :3] @ (s * p_part) + T[:3, 3], h.normal, s * h.diameter_m)
         return out
+
+    def _true_markers(self) -> MarkerTruth | None:
+        """The reference markers as they are (cell frame, m; None: the cell has none): off
+        their nominal by the truth's draw or offsets; those on the part carried by its true
+        placement and expanded with it about its true frame's origin."""
+        if not self.cell.reference_markers:
+            return None
+        tr = self.truth
+        mt = draw_marker_truth(self.cell, tr.seed, tr.marker_position_sigma_m,
+                               tr.part_placement_error, tr.marker_errors)  # fmt: skip
+        s = 1.0 + self.part_alpha_per_K * (tr.part_temperature_c - 20.0)
+        T = self.T_cell_part
+        p_part = (mt.true - T[:3, 3]) @ T[:3, :3]
+        grown = np.where(mt.on_fixture[:, None], mt.true, (s * p_part) @ T[:3, :3].T + T[:3, 3])
+        return replace(mt, true=grown)
 
     def part_reading_c(self) -> float:
         """A reading of the part's temperature (degC): the truth plus the thermometer's noise."""

@@ -20,7 +20,9 @@ Components (names as stored): ``circle_fit`` (the fit's covariance), ``stereo_ca
 (:mod:`cell.uncertainty.part_temperature`), ``cell_calibration`` (a run with ``--calibration``:
 the hand-eye and D-H terms' joint covariance carried to the hole's centre, first order,
 :meth:`cell.calibration.use.run_calibration.RunGeometry.point_covariance_cell`; without one the
-cell file's kinematics, base and head mount are taken as exact and the row is absent), and
+cell file's kinematics, base and head mount are taken as exact and the row is absent),
+``resection`` and ``survey_markers`` (a stop located against the surveyed markers, in place of
+the thermal model, the repeatability and the cell calibration: :mod:`cell.run.referenced`), and
 ``nonlinearity`` (the second-order term).
 """
 
@@ -34,7 +36,8 @@ import numpy as np
 #: coverage factor of the expanded uncertainty (about 95 % for a normal distribution)
 K_COVERAGE = 2.0
 COMPONENTS = ("circle_fit", "stereo_calibration", "thermal_model", "robot_repeatability",
-              "part_temperature", "cell_calibration", "nonlinearity")  # fmt: skip
+              "part_temperature", "cell_calibration", "resection", "survey_markers",
+              "nonlinearity")  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -204,3 +204,27 @@ def test_the_documented_truth_file_reads(tmp_path: Path) -> None:
     t = CellTruth.load(p)
     assert t.seed == 3 and t.dh_errors[0, 0] == -2.8e-4 and t.part_temperature_c == 22.5
     np.testing.assert_array_equal(t.dh_errors[1:], CellTruth.drawn(3).dh_errors[1:])
+
+
+def test_marker_truth_takes_offsets_and_refuses_unknown_ids(cell, tmp_path: Path) -> None:
+    """A marker's true position: the seeded draw, or the offset the truth file gives (a part
+    marker's offset in the part frame, moving with the part); an unknown id is refused."""
+    p = tmp_path / "truth.yaml"
+    p.write_text(
+        "seed: 3\nreference_markers:\n  position_error_sigma_m: 0.0\n"
+        "  errors: {T05: [0.002, 0.0, 0.0]}\n"
+    )
+    t = CellTruth.load(p, cell)
+    w = SimWorld(cell, WorldOptions(truth=replace(t, part_temperature_c=20.0)))
+    mt = w.markers
+    k = mt.ids.index("T05")
+    np.testing.assert_allclose(mt.true[k] - mt.nominal[k], [0.002, 0.0, 0.0], atol=1e-12)
+    fixture = [
+        i for i in range(len(mt.ids)) if mt.on_fixture[i] and mt.ids[i] not in ("T05", "T09", "T36")
+    ]  # a bar's far end sits at the bar's true length
+    np.testing.assert_allclose(mt.true[fixture], mt.nominal[fixture], atol=1e-12)
+    u = CellTruth.load(p, cell)
+    assert u.to_dict()["reference_markers"]["errors"] == {"T05": [0.002, 0.0, 0.0]}
+    p.write_text("reference_markers:\n  errors: {NOPE: [0.001, 0, 0]}\n")
+    with pytest.raises(TruthFileError, match=r"reference_markers\.errors\.NOPE"):
+        CellTruth.load(p, cell)

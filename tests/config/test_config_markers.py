@@ -41,6 +41,10 @@ def test_every_hole_of_the_built_in_cell_sees_four_spread_markers() -> None:
             MARKERS.replace("diameter_m: 0.005", "diameter_m: 5", 1),
             "reference_markers[0].diameter_m",
         ),
+        (  # the first marker carries code 1, which is the second one's place in the list
+            MARKERS.replace("on: part}", "on: part, code: 1}", 1),
+            "reference_markers[1].code: duplicate code",
+        ),
     ],
 )
 def test_bad_markers_are_refused_naming_the_field(tail: str, field: str) -> None:

@@ -24,18 +24,25 @@ import gtsam
 import numpy as np
 from gtsam.symbol_shorthand import C, L, R, X, Y
 
+from cell.referencing.errors import SurveyRefusedError
 from cell.referencing.survey.problem import Array, SurveyProblem
 from cell.referencing.survey.solution import RawSolution
 
 #: the datum prior on view 0 (m and rad). It acts only on the network's six free rigid motions,
 #: which absorb it exactly (no residual changes), and the gauge moves the result afterwards.
 DATUM_SIGMA = 1e-3
-#: how tightly each view's right camera follows the rig (rad, m)
-RIG_TIE_SIGMA = 1e-8
+#: how tightly each view's right camera follows the rig (rad, m); 1e-8 left the normal
+#: equations too ill-conditioned to factor on some networks (a six-hole cell, marker seed 5:
+#: no step taken), 1e-6 changes the built-in cell's network by under 0.1 um
+RIG_TIE_SIGMA = 1e-6
 #: the skew's prior (px): none in a real sensor
 SKEW_SIGMA = 1e-6
 #: the numerical step of the rig factor's Jacobians (rad, m)
 _H = 1e-7
+
+
+#: an adjustment that made no step and whose variance factor is above this is refused
+STUCK_VARIANCE_FACTOR = 100.0
 
 
 def _calibration(K: Array) -> gtsam.Cal3DS2:
@@ -120,13 +127,17 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     params.setMaxIterations(100)
     opt = gtsam.LevenbergMarquardtOptimizer(graph, values, params)
     result = opt.optimize()
+    n_obs = 2 * len(problem.uv) + len(problem.bars)
+    dof = max(n_obs - 6 * problem.n_views - 3 * problem.n_markers - 24, 1)
+    if opt.iterations() == 0 and 2.0 * graph.error(result) / dof > STUCK_VARIANCE_FACTOR:
+        raise SurveyRefusedError(
+            "the adjustment", "could not move from its start (an ill-posed network)"
+        )
     points = np.array([result.atPoint3(L(j)) for j in range(problem.n_markers)])
     poses = np.array([result.atPose3(X(v)).matrix() for v in range(problem.n_views)])
     cams = [result.atCal3DS2(C(c)) for c in range(2)]
     head = (_K(cams[0]), _K(cams[1]), result.atPose3(R(0)).matrix(), _lens(cams[0]), _lens(cams[1]))
     chi2 = 2.0 * graph.error(result)
-    n_obs = 2 * len(problem.uv) + len(problem.bars)
-    dof = max(n_obs - 6 * problem.n_views - 3 * problem.n_markers - 24, 1)
     cov = None
     if covariance:
         marginals = gtsam.Marginals(graph, result)

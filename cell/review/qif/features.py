@@ -142,7 +142,9 @@ def measured_features(
 ) -> None:
     """Fill ``<MeasuredFeatures>`` ``mf``: a circle measurement per measured hole (centre with
     ``combinedUncertainty`` = U_position/2, the measured axis when known, diameter with
-    ``combinedUncertainty`` = U_diameter/2; k = 2 is the report's coverage factor)."""
+    ``combinedUncertainty`` = U_diameter/2; k = 2 is the report's coverage factor); in a
+    referenced run an attribute ``located_by`` says by which markers the stop was located, or
+    that it fell back to the arm."""
     for h in holes:
         centre = measured_centre(h)
         if centre is None:
@@ -150,6 +152,10 @@ def measured_features(
         f = features[h["hole_id"]]
         f.measurement = ids.next()
         m = sub(mf, "CircleFeatureMeasurement", id=str(f.measurement))
+        if h.get("referenced") is not None:  # a referenced run: located by markers, or the arm
+            how = (f"markers {h.get('reference_markers') or ''}".strip() if h["referenced"]
+                   else "the arm's kinematic chain (fewer than 4 usable markers)")  # fmt: skip
+            sub(counted(m, "Attributes"), "AttributeStr", name="located_by", value=how)
         sub(m, "FeatureItemId", str(f.item))
         loc = sub(m, "Location", vec(centre))
         if h.get("U_position_m") is not None:

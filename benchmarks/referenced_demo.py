@@ -1,0 +1,119 @@
+"""Referenced against robot-only, on the same simulated truths, through the whole pipeline:
+``holecell demo`` with and without referencing (docs/referencing.md).
+
+For each seed the demo runs twice on the same truth (:meth:`cell.sim.truth.CellTruth.drawn`,
+or the large-error truth with ``--large``): once referenced (the survey tour driven on the
+simulated controller, the markers rendered, detected and identified in both cameras, one
+bundle adjustment, then every stop resected against the network from its own hole pair) and
+once robot-only (``--no-referencing``: the holes carried into the part by the calibrated arm
+and the thermal model). Both use the same cell calibration method (``--calibration-method``,
+default "projected": the plate's corners projected at the planned views, seconds instead of a
+minute of rendering; "images" drives the calibration tour as the demo does).
+
+Printed per seed and path: the survey against the true markers (RMS and worst after a rigid
+fit, scale error, markers within their stated 2 sigma), the holes' position error against the
+truth in the datum frame A|B|C in the hole plane (RMS, worst), the truth within U, the position
+characteristics with U <= 1/4 of their zone, the median U, the stops referenced, the survey's
+robot time and adjustment time, the resection's time per stop (median), the demo's wall time.
+``--arm-x`` and ``--thermal-x`` multiply the arm's repeatability and the thermal drift.
+
+    python benchmarks/referenced_demo.py [--seeds 3] [--large] [--arm-x 1] [--thermal-x 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from cell.config import load_builtin_cell
+from cell.demo.demo import DemoOptions, run_demo
+from cell.sim.truth import CellTruth
+from robots.transforms import so3_exp, so3_log
+
+
+def _large(t: CellTruth) -> CellTruth:
+    def grow(T: np.ndarray) -> np.ndarray:
+        out = np.eye(4)
+        out[:3, :3] = so3_exp(3 * so3_log(T[:3, :3]))
+        out[:3, 3] = 3 * T[:3, 3]
+        return out
+
+    return replace(t, dh_errors=3 * t.dh_errors, base_error=grow(t.base_error),
+                   tcp_error=grow(t.tcp_error),
+                   part_placement_error=grow(t.part_placement_error))  # fmt: skip
+
+
+def _figures(res, run_dir: Path) -> dict:
+    doc = json.loads((run_dir / "report.json").read_text())
+    pos = [c for c in doc.get("characteristics", [])
+           if c["kind"] == "position" and c.get("U_m") is not None]  # fmt: skip
+    refs = [h.extra.get("referencing") for h in res.run.stored]
+    out = {
+        "holes_rms_um": 1e6 * res.datum.rms_in_plane_m,
+        "holes_max_um": 1e6 * res.datum.max_in_plane_m,
+        "bestfit_rms_um": 1e6 * res.datum.best_fit_rms_in_plane_m,
+        "within_U": float(np.mean(res.datum.position_covered))
+        if res.datum.position_covered
+        else float("nan"),
+        "at_4to1": sum(c["U_m"] <= 0.25 * c["zone_diameter_m"] for c in pos),
+        "n_pos": len(pos),
+        "U_median_um": 1e6 * float(np.median([c["U_m"] for c in pos])) if pos else float("nan"),
+        "referenced": sum(1 for x in refs if x and x.get("referenced")),
+        "wall_s": res.timings["total_s"],
+    }
+    locate = [t.get("locate_s") for t in res.run.hole_timings if "locate_s" in t]
+    out["locate_ms"] = 1e3 * float(np.median(locate)) if locate else float("nan")
+    if res.survey is not None:
+        s = res.survey
+        out |= {"survey_rms_um": 1e6 * s.rms_m, "survey_max_um": 1e6 * s.worst_m,
+                "scale_ppm": s.scale_error_ppm, "within_2s": s.within_2sigma,
+                "survey_robot_s": s.robot_time_s, "survey_solve_s": s.solve_s,
+                "survey_s": s.seconds, "views": s.result.n_views}  # fmt: skip
+    return out
+
+
+COLS = ("seed", "path", "views", "survey_rms_um", "survey_max_um", "scale_ppm", "within_2s",
+        "survey_robot_s", "survey_solve_s", "referenced", "holes_rms_um", "holes_max_um",
+        "bestfit_rms_um", "within_U", "at_4to1", "n_pos", "U_median_um", "locate_ms",
+        "wall_s")  # fmt: skip
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--large", action="store_true", help="three times the realistic errors")
+    ap.add_argument("--arm-x", type=float, default=1.0, help="multiply the arm's repeatability")
+    ap.add_argument("--thermal-x", type=float, default=1.0, help="multiply the thermal drift")
+    ap.add_argument("--calibration-method", default="projected", choices=("projected", "images"))
+    ap.add_argument("--only", choices=("referenced", "robot"), default=None)
+    args = ap.parse_args()
+    cell = load_builtin_cell()
+    print("  ".join(f"{c:>14}" for c in COLS), flush=True)
+    for seed in range(args.first_seed, args.first_seed + args.seeds):
+        t = CellTruth.drawn(seed, cell)
+        t = _large(t) if args.large else t
+        t = replace(t, repeatability_rp_m=args.arm_x * t.repeatability_rp_m)
+        paths = [p for p in ("referenced", "robot") if args.only in (None, p)]
+        for path in paths:
+            with tempfile.TemporaryDirectory() as tmp:
+                run_dir = Path(tmp) / "demo"
+                opts = DemoOptions(seed=seed, truth=t, referencing=path == "referenced",
+                                   calibration_method=args.calibration_method,
+                                   thermal_scale=args.thermal_x)  # fmt: skip
+                t0 = time.perf_counter()
+                res = run_demo(run_dir, opts)
+                r = {"seed": seed, "path": path, **_figures(res, run_dir)}
+                r["wall_s"] = time.perf_counter() - t0
+            print("  ".join(f"{r.get(c, float('nan')):>14.4g}" if isinstance(r.get(c), float)
+                            else f"{r.get(c, '-')!s:>14}" for c in COLS), flush=True)  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

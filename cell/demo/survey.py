@@ -1,0 +1,98 @@
+"""The survey on the simulated cell: the survey tour driven on the simulated controller, the
+markers rendered and detected in both cameras, one adjustment (``holecell survey``'s
+procedure), ``markers.json`` written into the run directory, and the network compared with the
+simulator's true markers."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from cell.config import CellConfig
+from cell.referencing import save_markers
+from cell.referencing.markersfile import MARKERS_FILENAME
+from cell.referencing.survey.gauge import rigid_fit
+from cell.referencing.survey.result import SurveyResult
+from cell.referencing.survey.run import SurveyRunOptions, run_survey
+from cell.referencing.survey.tour import SurveyTour
+from cell.sim.session import SimCell
+
+
+@dataclass(frozen=True)
+class DemoSurvey:
+    """The survey's file, result, wall time (s), robot time (s), adjustment time (s) and its
+    error against the true markers: after a rigid fit (RMS and worst, m), the scale error (ppm,
+    from all the markers' distances), the share of coordinates within their stated 2 sigma (the
+    truth taken into the survey's gauge)."""
+
+    path: Path
+    result: SurveyResult
+    seconds: float
+    robot_time_s: float
+    rms_m: float
+    worst_m: float
+    solve_s: float = float("nan")
+    scale_error_ppm: float = float("nan")
+    within_2sigma: float = float("nan")
+
+
+def plan_demo_survey(seed: int) -> dict:
+    """The built-in cell's survey tour as ``holecell survey`` plans it (JSON-ready: planned in a
+    worker process)."""
+    from cell.camera import cell_stereo
+    from cell.config import load_builtin_cell
+    from cell.referencing.survey.tour import plan_survey_tour
+    from planner import Options
+
+    cell = load_builtin_cell()
+    planned = plan_survey_tour(cell, cell_stereo(cell), options=Options(seed=seed))
+    return {"tour": planned.tour.to_dict(),
+            "T_cell_left": {k: v.tolist() for k, v in planned.T_cell_left.items()},
+            "left_out": planned.left_out}  # fmt: skip
+
+
+def survey_tour_from_dict(data: dict) -> SurveyTour:
+    """The inverse of :func:`plan_demo_survey`."""
+    from planner.tour import tour_from_dict
+
+    return SurveyTour(tour_from_dict(data["tour"], "survey tour"),
+                      {k: np.asarray(v, float) for k, v in data["T_cell_left"].items()},
+                      dict(data["left_out"]))  # fmt: skip
+
+
+def survey_demo_cell(
+    sim: SimCell, cell: CellConfig, planned: SurveyTour, run_dir: Path, speed: float
+) -> DemoSurvey:
+    """Run the survey tour at ``speed`` (x real time), adjust, write ``run_dir/markers.json``."""
+    from cell.link.client import ControllerClient
+
+    t0 = time.perf_counter()
+    sim.world.clock.set_speed(speed)
+    try:
+        with ControllerClient(sim.url) as client:
+            done = run_survey(cell, planned, client, sim.camera, sim.camera.stereo,
+                              SurveyRunOptions(settle_s=0.2 / speed))  # fmt: skip
+    finally:
+        sim.world.clock.set_speed(1.0)
+    path = Path(run_dir) / MARKERS_FILENAME
+    save_markers(path, done.result, cell, sim.camera.stereo)
+    mt = sim.world.markers
+    r = done.result
+    rows = [mt.ids.index(m) for m in r.marker_ids]
+    true = mt.true[rows]
+    F = rigid_fit(r.positions_cell, true)
+    e = np.linalg.norm(r.positions_cell @ F[:3, :3].T + F[:3, 3] - true, axis=1)
+    P = r.positions_cell
+    d_est = np.linalg.norm(P[:, None] - P[None], axis=2)
+    d_true = np.linalg.norm(true[:, None] - true[None], axis=2)
+    scale = 1e6 * (np.sum(d_est * d_true) / np.sum(d_true**2) - 1.0)
+    # the survey's gauge: its fixture markers (or all of them) fitted to nominal
+    fixture = mt.on_fixture[rows] if r.gauge == "fixture markers" else np.ones(len(rows), bool)
+    G = rigid_fit(true[fixture], mt.nominal[rows][fixture])
+    z = np.abs(P - (true @ G[:3, :3].T + G[:3, 3])) / r.sigma_m()
+    return DemoSurvey(path, r, time.perf_counter() - t0, done.captures.robot_time_s,
+                      float(np.sqrt(np.mean(e**2))), float(e.max()), done.solve_s, float(scale),
+                      float(np.mean(z < 2.0)))  # fmt: skip

@@ -1,0 +1,69 @@
+"""The surveyed marker network as a run uses it: ``markers.json`` read and checked, with what
+the detector and the resection need of each marker (its code, nominal normal and dot radius).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cell.config import CellConfig
+from cell.config.markers import marker_codes, marker_in_cell
+from cell.referencing.errors import MarkersFileError
+from cell.referencing.markersfile import MAX_AGE_DAYS, check_markers, load_markers
+from measure import StereoCalibration
+
+Array = NDArray[np.float64]
+
+#: the marker centres' standard deviation per image axis assumed by the resection (px): the
+#: detector's figure on rendered images (docs/markers.md)
+DEFAULT_SIGMA_PX = 0.05
+
+
+@dataclass(frozen=True, eq=False)
+class MarkerNetwork:
+    """Surveyed markers ``ids``: ``positions_cell`` (n, 3) m, ``covariance`` (3n, 3n) m²,
+    nominal unit ``normals_cell`` (n, 3), dot ``radii_m`` (n,), ``codes`` (code -> id);
+    ``head``: the stereo head as the survey self-calibrated it (every referenced stop measures
+    with it); ``source``: the file and its date."""
+
+    ids: tuple[str, ...]
+    positions_cell: Array
+    covariance: Array
+    normals_cell: Array
+    radii_m: Array
+    codes: dict[int, str]
+    head: StereoCalibration
+    source: str
+    sigma_px: float = DEFAULT_SIGMA_PX
+
+    def index(self, marker_id: str) -> int:
+        return self.ids.index(marker_id)
+
+
+def load_network(
+    path: str | Path,
+    cell: CellConfig,
+    stereo: StereoCalibration,
+    max_age_days: float | None = MAX_AGE_DAYS,
+) -> MarkerNetwork:
+    """``markers.json`` of ``cell`` surveyed with ``stereo`` (refused, one line naming the
+    field, when it belongs to another cell, marker layout or head, or is too old; any age
+    with ``max_age_days`` None)."""
+    src = str(path)
+    doc, ids, P, C = load_markers(path)
+    check_markers(doc, src, cell, stereo, max_age_days)
+    try:
+        head = StereoCalibration.from_dict(doc["head"], f"{src} (head)")
+    except (KeyError, TypeError, ValueError) as exc:
+        raise MarkersFileError(src, "head", f"malformed ({exc})") from None
+    by_id = {m.id: m for m in cell.reference_markers}
+    T_cell_part = cell.T_cell_part()
+    normals = np.array([marker_in_cell(by_id[m], T_cell_part)[1] for m in ids])
+    radii = np.array([0.5 * by_id[m].diameter_m for m in ids])
+    codes = {c: m for c, m in marker_codes(cell.reference_markers).items() if m in set(ids)}
+    return MarkerNetwork(ids, P, C, normals, radii, codes, head,
+                         f"{src} ({doc.get('created_utc')})")  # fmt: skip

@@ -1,0 +1,122 @@
+"""A stop located against the surveyed markers (photogrammetric referencing, docs/referencing.md).
+
+At a referenced stop the markers are detected in both images of the hole's pair and the head's
+pose in the cell is solved by stereo resection (:func:`cell.referencing.resect`) about the arm's
+prior (its kinematics, calibration and thermal model). The hole is then carried into the cell by
+the resected pose, not by the arm. The arm's prior identifies the markers' expected places and
+is compared with the resection: a difference over :data:`ARM_DISAGREEMENT_M` is flagged (a bumped
+fixture, a moved marker, a wrong calibration). With fewer than four usable markers the stop is
+not referenced and the run uses the arm, as without referencing, with its own (larger) budget.
+
+Budget of a referenced stop (part frame, m²): the circle fit, the head's calibration (as without
+referencing: a conservative bound, the survey self-calibrated the head), the resection's image
+noise, the survey's marker covariance carried through the resection, the part's temperature.
+The arm's repeatability, kinematic calibration and thermal model are not in it: the arm only
+carried the head.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cell.referencing.detection import Detections, observe_detections
+from cell.referencing.network import MarkerNetwork
+from cell.referencing.observations import MarkerView
+from cell.referencing.resection import Resection, resect
+from cell.uncertainty.budget import Contribution
+
+Array = NDArray[np.float64]
+
+#: the resected head and the arm's idea of it may differ by this much before it is flagged (m)
+ARM_DISAGREEMENT_M = 1e-3
+
+
+@dataclass(frozen=True, eq=False)
+class LocatedStop:
+    """A stop's resection (``resection.ok`` False: not referenced, ``resection.reason`` why),
+    the markers seen (``view``), and how far the arm's prior was from it (m, rad)."""
+
+    resection: Resection
+    view: MarkerView
+    T_cell_left_arm: Array
+    disagreement_m: float
+    disagreement_rad: float
+
+    @property
+    def referenced(self) -> bool:
+        return bool(self.resection.ok)
+
+    @property
+    def flagged(self) -> bool:
+        """The resection and the arm disagree by more than :data:`ARM_DISAGREEMENT_M`."""
+        return self.referenced and self.disagreement_m > ARM_DISAGREEMENT_M
+
+    def to_dict(self) -> dict[str, Any]:
+        """What a hole result stores of it (``extra["referencing"]``)."""
+        r = self.resection
+        out: dict[str, Any] = {
+            "referenced": self.referenced,
+            "markers": list(r.used),
+            "refused": dict(r.refused),
+            "seen_left": sorted(self.view.uv_left),
+            "seen_right": sorted(self.view.uv_right),
+        }
+        if self.referenced:
+            out |= {"rms_px": r.rms_px, "arm_disagreement_m": self.disagreement_m,
+                    "arm_disagreement_rad": self.disagreement_rad,
+                    "T_cell_left": r.T_cell_left.tolist(),
+                    "T_cell_left_arm": self.T_cell_left_arm.tolist()}  # fmt: skip
+        else:
+            out["reason"] = r.reason
+        return out
+
+
+def locate_stop(
+    network: MarkerNetwork,
+    detections: Detections,
+    T_cell_left_arm: Array,
+    view_id: str,
+) -> LocatedStop:
+    """Resect the head against the surveyed markers detected in the pair
+    (:func:`cell.referencing.detection.detect_pair`), about the arm's pose."""
+    geometry = {m: (network.positions_cell[k], network.normals_cell[k], float(network.radii_m[k]))
+                for k, m in enumerate(network.ids)}  # fmt: skip
+    view = observe_detections(detections, network.head, network.codes, geometry, view_id,
+                              T_cell_left_arm)  # fmt: skip
+    r = resect(view, network.head, network.ids, network.positions_cell, network.covariance,
+               network.sigma_px)  # fmt: skip
+    dt, dr = math.nan, math.nan
+    if r.ok:
+        D = np.linalg.inv(T_cell_left_arm) @ r.T_cell_left
+        dt = float(np.linalg.norm(r.T_cell_left[:3, 3] - T_cell_left_arm[:3, 3]))
+        dr = float(np.arccos(np.clip((np.trace(D[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)))
+    return LocatedStop(r, view, np.asarray(T_cell_left_arm, float), dt, dr)
+
+
+def referenced_contributions(
+    located: LocatedStop,
+    center_left_m: Array,
+    R_part_cell: Array,
+    fit: Contribution,
+    calibration: Contribution,
+    temperature: Contribution,
+    network_source: str,
+) -> list[Contribution]:
+    """The budget rows of a referenced stop (module doc): the fit, the head's calibration and
+    the part temperature as given, the resection's image noise and the survey's markers."""
+    r = located.resection
+    J = R_part_cell @ r.point_jacobian(center_left_m)
+    cov_m = r.covariance_markers if r.covariance_markers is not None else np.zeros((6, 6))
+    image = Contribution(
+        "resection", J @ (r.covariance - cov_m) @ J.T, 0.0,
+        f"stereo resection on {len(r.used)} markers ({', '.join(r.used)}), "
+        f"{r.rms_px:.3f} px RMS",
+    )  # fmt: skip
+    survey = Contribution("survey_markers", J @ cov_m @ J.T, 0.0,
+                          f"the surveyed markers' covariance ({network_source})")  # fmt: skip
+    return [fit, calibration, image, survey, temperature]
