@@ -64,7 +64,12 @@ def _ring_white(u, v, ux, uy, vx, vy, r, rx, ry, ju2, sectors, r_in, r_out) -> f
     f = -s * u + c * v
     gx, gy = -s * ux + c * vx, -s * uy + c * vy
     g = math.sqrt(gx * gx + gy * gy) + 1e-300
-    above = edge_coverage(f / g, gx, gy)
+    if f >= g:  # a pixel or more from the sector boundary: wholly in one sector
+        above = 1.0
+    elif f <= -g:
+        above = 0.0
+    else:
+        above = edge_coverage(f / g, gx, gy)
     white = sectors[k % n] * above + sectors[(k - 1) % n] * (1.0 - above)
     return band * white
 
@@ -143,6 +148,20 @@ def marker_patch(grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels
             r = math.sqrt(u * u + v * v) + 1e-12
             rx, ry = (u * ux + v * vx) / r, (u * uy + v * vy) / r  # grad r, per pixel
             g = math.sqrt(rx * rx + ry * ry) + 1e-300
+            if kind == RING:
+                if r - geo[2] >= g:
+                    continue  # a pixel or more outside the label
+                near = min(abs(r - 0.5), abs(r - geo[0]), abs(r - geo[1]), abs(r - geo[2])) < g
+                if not near:  # no circle edge within a pixel: only sector boundaries
+                    label = 1.0
+                    wc = 1.0 if r < 0.5 else 0.0
+                    if geo[0] < r < geo[1]:
+                        wc = _ring_white(
+                            u, v, ux, uy, vx, vy, r, rx, ry, 0.0, sectors, geo[0], geo[1]
+                        )
+                    refl = black * (label - wc) + white_level * wc
+                    out[yy, xx] = refl * lit[yy, xx]
+                    continue
             tx, ty = -ry / g, rx / g  # unit tangent of the circle through the pixel
             ju, jv = ux * tx + uy * ty, vx * tx + vy * ty
             ju2 = ju * ju + jv * jv

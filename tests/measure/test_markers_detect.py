@@ -62,6 +62,15 @@ def test_no_marker_on_hole_scenes_and_markers_beside_a_hole():
         ]
 
 
+def test_12_bit_colour_images():
+    """A 12-bit Bayer camera's demosaiced BGR image (uint16) is read as gray."""
+    st, _, _, ms = ring_of_markers([40, 41, 42], tilt_deg=25.0)
+    r = render_markers_pair(st, ms, RenderOptions(bit_depth=12, bayer=True), seed=5)
+    assert r.left.dtype == np.uint16 and r.left.ndim == 3
+    dets = detect_markers(r.left, st.K_left, st.dist_left)
+    assert [m.code for m in dets] == [40, 41, 42]
+
+
 def test_bad_image_is_refused_with_a_clear_error():
     with pytest.raises(ImageError, match="uint8 or uint16"):
         detect_markers(np.zeros((20, 20), dtype=np.float32))
