@@ -67,7 +67,8 @@ class Roadmap:
         if not len(u):
             return None
         weights = np.maximum(G[u, v], 1e-9)
-        if self._weights is None or not np.array_equal(self._weights, weights):
+        grown = any(len(row[0]) != G.shape[0] for row in self._rows.values())  # nodes added
+        if self._weights is None or grown or not np.array_equal(self._weights, weights):
             self._rows, self._weights = {}, weights
         todo = [s for s in sources if s not in self._rows]
         if todo:
