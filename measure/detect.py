@@ -268,11 +268,11 @@ def find_candidates(
     small = cv2.medianBlur(small, 3)  # texture and noise specks would each be an outline
     found = {}
     tally = [0]
-    p_lo, p_med, p_hi = quantiles = tuple(quantiles_u8(small, (0.001, 0.5, 0.999)))
+    p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
     if stats is not None:
         stats["contrast"] = {"dark": (p_med - p_lo) / 255.0, "bright": (p_hi - p_med) / 255.0}
     for border_only in (False, True):  # regions cut by the border only when nothing else
-        for polarity, thresholds, extreme in _levels(quantiles):
+        for polarity, thresholds, extreme in _levels((p_lo, p_med, p_hi)):
             discs = []
             for k, thr in enumerate(thresholds):
                 mask = (small <= thr) if polarity == "dark" else (small > thr)
