@@ -112,12 +112,14 @@ def main(argv: list[str] | None = None) -> int:
     )
     if res.calibration is not None and res.calibration.tour_note:
         print(f"calibration tour: {res.calibration.tour_note}")
+    speed = DemoOptions().calibration_speed
     for run in _runs:
-        w = run.captures.wall  # type: ignore[attr-defined]
+        caps = run.captures  # type: ignore[attr-defined]
         print(
             "calibration tour walls: "
-            + ", ".join(f"{k} {v:.1f} s" for k, v in w.items())
-            + f"; robot time {run.captures.robot_time_s:.0f} s"  # type: ignore[attr-defined]
+            + ", ".join(f"{k} {v:.1f} s" for k, v in caps.wall_s.items())
+            + f"; robot time {caps.robot_time_s:.0f} s, at {speed:g}x: "
+            f"{caps.robot_time_s / speed:.0f} s of wall at least"
         )
     laps: dict[str, float] = defaultdict(float)
     for h in res.run.hole_timings:
