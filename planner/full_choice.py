@@ -64,7 +64,7 @@ def layered_choice(
     return rows[::-1], float(total[last])
 
 
-def task_space_order(positions_m: NDArray[np.float64], time_cap_s: float = 5.0) -> list[int]:
+def task_space_order(positions_m: NDArray[np.float64], time_cap_s: float = 60.0) -> list[int]:
     """A short tour through viewpoint positions (row 0: home TCP, row h + 1: hole h; m):
     OR-Tools routing (cheapest arc, then guided local search) stopped after
     ``TSP_SOLUTIONS`` solutions, a work limit (``time_cap_s`` only binds on a crawling

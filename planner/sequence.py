@@ -43,6 +43,9 @@ PYVRP_ITERATIONS = (500, 20)
 #: the task-space baseline by 9 % at 250 holes) and at most this many rounds per start
 POLISH_MAX_HOLES = 120
 POLISH_ROUNDS = 4
+#: work of the polish's searches: the full search's divided by this, for the first search
+#: from the task-space tour and for the others (warm starts near a local optimum)
+POLISH_WORK = (1, 4)
 
 
 @dataclass(frozen=True)
@@ -299,14 +302,14 @@ class GtspSequencer:
         starts = [[int(self.owner[v]) for v in visited]]
         if self.task_order is not None:
             starts.append(list(self.task_order))
+        div = {True: POLISH_WORK[0], False: POLISH_WORK[1]}
         for k, order in enumerate(starts):
             for r in range(POLISH_ROUNDS):
                 tour = self.every_candidate(order)
-                left = budget_s / (len(starts) * POLISH_ROUNDS)
                 s = LnsSettings(
-                    max_iterations=settings.max_iterations // (1 if r == 0 and k else 4),
-                    patience=settings.patience // (1 if r == 0 and k else 4),
-                    time_limit_s=max(left, 1e-3),
+                    max_iterations=settings.max_iterations // div[r == 0 and k > 0],
+                    patience=settings.patience // div[r == 0 and k > 0],
+                    time_limit_s=budget_s,  # thread CPU time: binds on a crawling machine only
                 )
                 start = [int(self.owner[v]) for v in tour]
                 near = self.near_holes() if len(self.groups) > NEAR_ABOVE else None
@@ -348,8 +351,7 @@ class GtspSequencer:
             found = GtspLns(self.G, self.groups, seed, record, near).run(settings, start)
             visited, hit = found.nodes, found.hit_time_limit
             if not short and n <= POLISH_MAX_HOLES:
-                budget = time_budget_s - (time.perf_counter() - started)
-                visited, hit2 = self._polish(visited, settings, budget, seed, record)
+                visited, hit2 = self._polish(visited, settings, time_budget_s, seed, record)
                 hit = hit or hit2
         elif self.method == "pyvrp":
             base, per_hole = PYVRP_ITERATIONS
