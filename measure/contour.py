@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy.ndimage import median_filter
 
 #: ``cv2.fitEllipse`` style: ((cx, cy), (full axis 1, full axis 2), angle in degrees)
 Ellipse = tuple[tuple[float, float], tuple[float, float], float]
@@ -119,14 +120,17 @@ def _ellipse_points(ell: Ellipse, centroid: np.ndarray, angles: np.ndarray) -> n
     return centroid + t_hit[:, None] * dirs
 
 
+def _wrap(a: np.ndarray) -> np.ndarray:
+    """Angles (rad) wrapped to [−π, π)."""
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
 def _polar_clean(r: np.ndarray, window: int = 9) -> np.ndarray:
     """Mask of samples within 1 px of a running median of r (sorted by angle, periodic)."""
     n = len(r)
     if n < window:
         return np.ones(n, dtype=bool)
-    half = window // 2
-    idx = (np.arange(n)[:, None] + np.arange(-half, half + 1)[None, :]) % n
-    med = np.median(r[idx], axis=1)
+    med = median_filter(r, size=window, mode="wrap")
     return np.abs(r - med) < 1.0
 
 
@@ -186,9 +190,9 @@ def build_contour(
     # angular distance from each line to the nearest measured sample (periodic)
     j = np.searchsorted(theta, ang) % len(theta)
     jm = (j - 1) % len(theta)
-    gap_a = np.abs(np.angle(np.exp(1j * (ang - theta[j]))))
-    gap_b = np.abs(np.angle(np.exp(1j * (ang - theta[jm]))))
-    span = np.abs(np.angle(np.exp(1j * (theta[j] - theta[jm])))) * r_mean  # bracketing gap, px
+    gap_a = np.abs(_wrap(ang - theta[j]))
+    gap_b = np.abs(_wrap(ang - theta[jm]))
+    span = np.abs(_wrap(theta[j] - theta[jm])) * r_mean  # bracketing gap, px
     filled = span > short_gap_px * 0.5 + arc_step_px
     long_gap = span > short_gap_px
     near = np.minimum(gap_a, gap_b) * r_mean

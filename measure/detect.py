@@ -80,9 +80,10 @@ class HoleCandidate:
     surface_level: float | None = None
 
 
-def _levels(small: np.ndarray):
-    """(polarity, [thresholds 0..255], extreme level) for the dark class, then the bright."""
-    p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
+def _levels(quantiles: tuple[float, float, float]):
+    """(polarity, [thresholds 0..255], extreme level) for the dark class, then the bright,
+    from the search image's 0.1 %, 50 % and 99.9 % quantiles."""
+    p_lo, p_med, p_hi = quantiles
     if p_med - p_lo >= 0.2 * 255:
         yield "dark", [p_lo + f * (p_med - p_lo) for f in LADDER], p_lo
     if p_hi - p_med >= 0.2 * 255:
@@ -267,11 +268,11 @@ def find_candidates(
     small = cv2.medianBlur(small, 3)  # texture and noise specks would each be an outline
     found = {}
     tally = [0]
+    p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
     if stats is not None:
-        p_lo, p_med, p_hi = quantiles_u8(small, (0.001, 0.5, 0.999))
         stats["contrast"] = {"dark": (p_med - p_lo) / 255.0, "bright": (p_hi - p_med) / 255.0}
     for border_only in (False, True):  # regions cut by the border only when nothing else
-        for polarity, thresholds, extreme in _levels(small):
+        for polarity, thresholds, extreme in _levels((p_lo, p_med, p_hi)):
             discs = []
             for k, thr in enumerate(thresholds):
                 mask = (small <= thr) if polarity == "dark" else (small > thr)

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+from scipy.ndimage import median_filter
 
 #: the inside slope is read this many blur σ from the edge point
 SLOPE_OFFSET_SIGMA = 3.0
@@ -63,10 +64,8 @@ def _running_median(values: np.ndarray, angles: np.ndarray, window: int) -> np.n
     if window <= 1 or n <= window:
         return values
     order = np.argsort(angles)
-    half = window // 2
-    idx = (np.arange(n)[:, None] + np.arange(-half, half + 1)[None, :]) % n
     out = np.empty(n)
-    out[order] = np.median(values[order][idx], axis=1)
+    out[order] = median_filter(values[order], size=window, mode="wrap")
     return out
 
 

@@ -30,8 +30,9 @@ class Options:
         seed: seed of every random choice (sequencer and OMPL); the same seed gives the same tour.
         time_budget_s: hard cap on the sequencer's search (s); ``None``: 1 s + 0.015 s per hole.
         effort: work of the search relative to the default (iterations and patience scale with it).
-        nodes_per_hole: candidate configurations per hole the search works with (the final
-            choice of configuration for the found order considers every candidate).
+        nodes_per_hole: candidate configurations per hole the search starts with (up to 120
+            holes the task-space tour's and the found order's best configurations among
+            every candidate join them: :mod:`planner.full_choice`).
         sequencer: ``"lns"`` (large-neighbourhood search, default), ``"pyvrp"`` (PyVRP,
             one optional client per candidate, one required group per hole) or ``"ortools"``
             (OR-Tools routing with one disjunction per hole).

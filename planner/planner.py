@@ -30,6 +30,7 @@ from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
 from planner.roadmap import Roadmap, build_roadmap, detour_costs
 from planner.route import Route, route_stops
+from planner.sampling import tcp_positions
 from planner.segments import Segment, SegmentCache
 from planner.sequence import GtspSequencer, SequenceResult
 from planner.shared import SharedPlan, options_key, unpack
@@ -289,7 +290,14 @@ class TourPlanner(LazyEdgeChecks):
         seqr = None
         if self.sequencer is None:
             self.progress("sequence", 0, 1)
-            seqr = GtspSequencer(home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer)
+            # viewpoint positions (home's TCP first): the polish's task-space start
+            xyz = np.vstack(
+                [tcp_positions(arm, home[None, :])] + [c.poses[0][:3, 3] for c in cands]
+            )
+            seqr = GtspSequencer(
+                home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer, positions_m=xyz
+            )
+            seqr.add_task_space_nodes()  # before the roadmap: their motions are checked too
             self._build_roadmap(seqr, checker)
         timings["sequence"] = time.perf_counter() - t
         return SharedPlan(

@@ -67,7 +67,8 @@ class Roadmap:
         if not len(u):
             return None
         weights = np.maximum(G[u, v], 1e-9)
-        if self._weights is None or not np.array_equal(self._weights, weights):
+        grown = any(len(row[0]) != G.shape[0] for row in self._rows.values())  # nodes added
+        if self._weights is None or grown or not np.array_equal(self._weights, weights):
             self._rows, self._weights = {}, weights
         todo = [s for s in sources if s not in self._rows]
         if todo:
@@ -85,16 +86,26 @@ class Roadmap:
         return path
 
 
+#: rows per block of :func:`neighbour_pairs` (the same rows as the whole matrix at once)
+NEIGHBOUR_BLOCK = 256
+
+
 def neighbour_pairs(G: NDArray[np.float64], owner: NDArray[np.int64], k: int) -> np.ndarray:
     """Undirected pairs (u < v) joining each node to its ``k`` nearest nodes of other holes."""
     N = G.shape[0]
-    D = np.minimum(G, G.T).astype(float)
-    D[owner[:, None] == owner[None, :]] = np.inf  # same hole (and home with itself)
     k = min(k, N - 1)
-    near = np.argpartition(D, k - 1, axis=1)[:, :k] if k > 0 else np.zeros((N, 0), int)
+    near = np.zeros((N, max(k, 0)), dtype=np.int64)
+    nearest = np.zeros((N, max(k, 0)))
+    for r0 in range(0, N if k > 0 else 0, NEIGHBOUR_BLOCK):  # row blocks: cache-friendly
+        r1 = min(r0 + NEIGHBOUR_BLOCK, N)
+        D = np.minimum(G[r0:r1], G[:, r0:r1].T)
+        D[owner[r0:r1, None] == owner[None, :]] = np.inf  # same hole (and home with itself)
+        part = np.argpartition(D, k - 1, axis=1)[:, :k]
+        near[r0:r1] = part
+        nearest[r0:r1] = np.take_along_axis(D, part, axis=1)
     u = np.repeat(np.arange(N), near.shape[1])
     v = near.ravel()
-    ok = np.isfinite(D[u, v])
+    ok = np.isfinite(nearest.ravel())
     pairs = np.unique(np.sort(np.column_stack([u[ok], v[ok]]), axis=1), axis=0)
     return pairs
 

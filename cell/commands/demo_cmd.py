@@ -127,6 +127,7 @@ def format_calibration(res: DemoResult) -> str:
     rms = ", ".join(f"{k} {v:.3f} px" for k, v in cal.residual_rms_px.items())
     rows = [
         ("cell calibration", f"{c.method}: {c.seconds:.1f} s"),
+        *([("  calibration tour", c.tour_note)] if c.tour_note else []),
         ("  hand-eye error vs truth", f"{c.hand_eye_error_m * 1e3:.4f} mm, "
                                       f"{np.degrees(c.hand_eye_error_rad):.4f} deg (sigma "
                                       f"{c.hand_eye_sigma_m * 1e3:.4f} mm, "

@@ -28,6 +28,7 @@ from cell.calibration.estimate import CellCalibration, SolveOptions, pose_error,
 from cell.calibration.file import save_calibration
 from cell.calibration.use import RUN_FILENAME
 from cell.config import CellConfig
+from cell.demo.caltour_cache import cached_caltour, caltour_key
 from cell.demo.sim_calibration import design_views, simulated_calibration, synthetic_truth
 from cell.sim.session import SimCell
 from planner import Tour
@@ -51,6 +52,7 @@ class DemoCalibration:
     hand_eye_error_rad: float
     fixed_terms: tuple[str, ...]
     method: str
+    tour_note: str = ""  # how the calibration tour was had (planned, or from the cache)
 
     @property
     def hand_eye_sigma_m(self) -> float:
@@ -87,7 +89,9 @@ def calibrate_demo_cell(
 
 def plan_demo_caltour(views: int, seed: int) -> dict:
     """The built-in cell's calibration tour as ``holecell calibrate cell`` plans it (JSON-ready:
-    planned in a worker process)."""
+    planned in a worker process), planned once per cell, view count, seed and code and then
+    read from the user's cache folder (:mod:`cell.demo.caltour_cache`; its ``settings``
+    key ``plan_cache`` says which)."""
     from cell.calibration.plan import calibrate_plan_options, plan_cell_calibration
     from cell.camera import cell_stereo
     from cell.config import load_builtin_cell
@@ -95,7 +99,12 @@ def plan_demo_caltour(views: int, seed: int) -> dict:
     cell = load_builtin_cell()
     opts = replace(calibrate_plan_options(views, seed), criterion=CALTOUR_CRITERION,
                    predict=False)  # fmt: skip
-    return plan_cell_calibration(cell, cell_stereo(cell), opts).to_dict()
+    data, note = cached_caltour(
+        caltour_key(cell, opts, views, seed),
+        lambda: plan_cell_calibration(cell, cell_stereo(cell), opts).to_dict(),
+    )
+    data.setdefault("settings", {})["plan_cache"] = note  # printed with the calibration
+    return data
 
 
 def calibrate_demo_cell_images(
@@ -127,4 +136,5 @@ def calibrate_demo_cell_images(
     method = (f"calibration tour of {len(caltour.tour.stops)} views driven on the simulated "
               f"controller ({run.captures.robot_time_s:.0f} s robot time), plate rendered and "
               f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s")  # fmt: skip
-    return DemoCalibration(path, cal, seconds, dp, dr, fixed, method)
+    note = str(caltour.tour.settings.get("plan_cache", ""))
+    return DemoCalibration(path, cal, seconds, dp, dr, fixed, method, note)

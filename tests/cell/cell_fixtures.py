@@ -5,6 +5,7 @@ directory's ``conftest``."""
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -71,3 +72,18 @@ def link_for(controller: str, options):
     if controller != "rapid":
         return options
     return replace(options, response_timeout_s=max(options.response_timeout_s, 0.15))
+
+
+@pytest.fixture(scope="session", autouse=True)
+def private_cache(tmp_path_factory: pytest.TempPathFactory):
+    """holecell's cache folder is a temporary one in these tests (the demo's calibration tour
+    is planned once and read back as in use, but never from or into the user's cache)."""
+    from cell.demo.caltour_cache import CACHE_ENV
+
+    before = os.environ.get(CACHE_ENV)
+    os.environ[CACHE_ENV] = str(tmp_path_factory.mktemp("holecell-cache"))
+    yield
+    if before is None:
+        os.environ.pop(CACHE_ENV, None)
+    else:
+        os.environ[CACHE_ENV] = before

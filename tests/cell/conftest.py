@@ -1,5 +1,5 @@
 """Fixtures of the cell tests (defined in :mod:`cell_fixtures`)."""
 
-from cell_fixtures import controller, controller_rapid_slow, small_cell
+from cell_fixtures import controller, controller_rapid_slow, private_cache, small_cell
 
-__all__ = ["controller", "controller_rapid_slow", "small_cell"]
+__all__ = ["controller", "controller_rapid_slow", "private_cache", "small_cell"]
