@@ -137,7 +137,7 @@ def format_demo(res: DemoResult) -> str:
     """The summary table (mm and um for people)."""
     s, t, tr, dt = res.summary, res.timings, res.truth, res.datum
     measured, planned = s["holes_measured"], s["holes_planned"]
-    worst = s["worst_position_deviation_m"]
+    worst = s["worst_position_m"]
     rows = [
         ("holes measured", f"{bar(measured, planned, 20)} {measured}/{planned}"),
         ("missing / unmeasurable", f"{s['holes_missing']} / {s['holes_unmeasured']}"),
@@ -146,11 +146,12 @@ def format_demo(res: DemoResult) -> str:
         ("decisions (ISO 14253-1)" if s.get("decision_rule") != "simple" else "decisions (simple)",
          f"{s['holes_conforming']} conformance proven / {s['holes_inconclusive']} inconclusive "
          f"/ {s['holes_nonconforming']} nonconformance proven"),
-        ("largest U (k=2)", f"position {s['max_U_position_m'] * 1e6:.1f} um, diameter "
-                            f"{s['max_U_diameter_m'] * 1e6:.1f} um" if s["max_U_position_m"]
+        ("largest U (k=2)", f"position ⌀{s['max_U_position_m'] * 1e6:.1f} µm, diameter "
+                            f"{s['max_U_diameter_m'] * 1e6:.1f} µm" if s["max_U_position_m"]
                             else "-"),
         ("part temperature", _part(s.get("part"))),
-        ("worst deviation", f"{worst * 1e3:.4f} mm (hole {s['worst_hole']})" if worst else "-"),
+        ("worst position", f"⌀{worst * 1e3:.4f} mm (ISO 1101; hole {s['worst_hole']}, "
+                           f"{s['worst_position_frame']} frame)" if worst else "-"),
         ("cycle time (planned)", f"{res.tour.cycle_time_s:.1f} s"),
         ("position error vs truth", _datum(dt)),
         ("  best fit", _best_fit(dt)),

@@ -87,7 +87,8 @@ def _counts(summ: dict[str, Any]) -> str:
 
 def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]]) -> str:
     head = ("<tr><th class='l'>hole</th><th>stop</th><th>nominal x / y / z (mm)</th>"
-            "<th>actual x / y / z (mm)</th><th>position dev. (um)</th><th>U pos. (um)</th>"
+            "<th>actual x / y / z (mm)</th><th>position &#8960; (um)</th>"
+            "<th>U pos. &#8960; (um)</th>"
             "<th>nominal dia. (mm)</th><th>actual dia. (mm)</th><th>dia. dev. (um)</th>"
             "<th>U dia. (um)</th><th>tolerance (um)</th><th class='l'>decision</th>"
             "<th class='l'>status</th></tr>")  # fmt: skip
@@ -109,8 +110,8 @@ def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]])
         rows.append(
             f'<tr class="hole" data-hole="{escape(r.hole_id)}" data-decision="{cls}">'
             f"<td class='l'>{escape(r.hole_id)}</td><td>{r.stop_index}</td><td>{nom_s}</td>"
-            f"<td>{act}</td><td>{_fmt(r.position_deviation_m, 1e6, 1)}</td>"
-            f"<td class='U'>{_fmt(r.U_position_m, 1e6, 1)}</td>"
+            f"<td>{act}</td><td>{_fmt(r.position_deviation_m, 2e6, 1)}</td>"
+            f"<td class='U'>{_fmt(r.U_position_m, 2e6, 1)}</td>"
             f"<td>{_fmt(r.nominal_diameter_m, 1e3, 3)}</td><td>{_fmt(r.diameter_m, 1e3, 4)}</td>"
             f"<td>{_fmt(r.diameter_deviation_m, 1e6, 1)}</td>"
             f"<td class='U'>{_fmt(r.U_diameter_m, 1e6, 1)}</td>"
@@ -154,16 +155,17 @@ def _vector_plot(results: list[HoleResult]) -> str:
     return svg(W, H, body, "deviation vectors over the part (side view, x-z)")
 
 
-def _bar_plot(results: list[HoleResult], key: str, ukey: str, label: str) -> str:
-    """|deviation| per hole with its U as an error bar, and the tolerance."""
+def _bar_plot(results: list[HoleResult], key: str, ukey: str, label: str,
+              scale: float = 1.0) -> str:  # fmt: skip
+    """|deviation| per hole (times ``scale``) with its U as an error bar, and the tolerance."""
     m = [r for r in results if r.measured and getattr(r, key) is not None]
     W, row = 900, 13
     H = 60 + row * max(len(m), 1)
     if not m:
         return svg(W, 60, [text(10, 30, "no measured hole")], label)
-    vals = np.array([abs(getattr(r, key)) for r in m]) * 1e6
-    us = np.array([getattr(r, ukey) or 0.0 for r in m]) * 1e6
-    tol = max((r.tolerance_m or 0.0) for r in m) * 1e6
+    vals = np.array([abs(getattr(r, key)) for r in m]) * 1e6 * scale
+    us = np.array([getattr(r, ukey) or 0.0 for r in m]) * 1e6 * scale
+    tol = max((r.tolerance_m or 0.0) for r in m) * 1e6 * scale
     hi = max(float((vals + us).max()), tol) * 1.08
     ax = Axes(W, H, (0.0, hi), (0.0, float(len(m))), margin=(70, 20, 10, 35))
     body = frame(ax, f"{label} (um)", "", ticks(0.0, hi), [])
@@ -262,14 +264,15 @@ def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleRe
         _header(summ, info, operator, results),
         "<h2>Result</h2>", _counts(summ), gdt_html,
         "<h2>Holes</h2>", _hole_table(results, planned),
-        "<p class='note'>Position deviation: distance of the measured centre from the nominal in "
+        "<p class='note'>Position &#8960; (ISO 1101): the diameter of the zone about the "
+        "nominal axis that holds the measured centre, 2 &#215; its distance from the nominal in "
         "the plane perpendicular to the nominal axis, in the run's alignment (above; the "
         "positions are in the part frame). U: expanded uncertainty (k = 2). Decisions per "
         "ISO 14253-1 on both characteristics.</p>",
         *(["<h2>Deviation vectors over the part</h2>", _vector_plot(results)]
           if fixture_plot else []),
-        "<h2>Position deviation against the tolerance</h2>",
-        _bar_plot(results, "position_deviation_m", "U_position_m", "position deviation"),
+        "<h2>Position &#8960; against the tolerance</h2>",
+        _bar_plot(results, "position_deviation_m", "U_position_m", "position ⌀", 2.0),
         "<h2>Diameter deviation against the tolerance</h2>",
         _bar_plot(results, "diameter_deviation_m", "U_diameter_m", "|diameter deviation|"),
         "<h2>Thermal drift over the run</h2>", _thermal_plot(results, reference or []),
