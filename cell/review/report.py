@@ -140,7 +140,8 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
         reference = [(o[0], o[3]) for o in store.reference_observations()]
     gdt, results = report_evaluation(info, results, rows, summ)  # cell.gdt, docs/gdt.md
     html = render_html(summ, info, results, planned, operator, reference,
-                       gdt_section(gdt.fields()), gdt.alignment == "fixture")  # fmt: skip
+                       gdt_section(gdt.fields()), gdt.alignment == "fixture",
+                       gdt.characteristics)  # fmt: skip
     write_text_atomic(run_dir / "report.html", html)
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events, **gdt.fields()}  # fmt: skip

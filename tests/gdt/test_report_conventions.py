@@ -41,7 +41,7 @@ def test_the_summary_json_and_html_give_the_position_as_a_diameter(report) -> No
     cells = re.findall(r"<td[^>]*>([^<]*)</td>", row)
     assert cells[4] == f"{worst['value_m'] * 1e6:.1f}"  # the holes table's position ⌀ (um)
     assert cells[5] == f"{worst['U_m'] * 1e6:.1f}"
-    assert "position &#8960; (um)" in html
+    assert "position &#8960; (µm)" in html
 
 
 def test_the_live_line_gives_the_diameter_and_its_frame() -> None:
