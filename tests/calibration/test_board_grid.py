@@ -19,22 +19,29 @@ from measure.target_grid import grid_problem
 @pytest.fixture(scope="module")
 def example(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("ex") / "set"
-    assert main(["calibrate", "example", str(folder), "--views", "4"]) == 0
+    assert main(["calibrate", "example", str(folder)]) == 0
     return folder
 
 
 def test_the_plate_edge_is_not_a_ninth_column(example: Path) -> None:
-    img = cv2.imread(str(example / "L00.png"), cv2.IMREAD_GRAYSCALE)
-    right = find_target(img, TargetSpec("chessboard", 8, 6, 0.012))
-    assert right.points is not None, right.reason
     spec = TargetSpec("chessboard", 9, 6, 0.012)
-    # what OpenCV alone returns: 54 "corners", one column on the plate's edge
-    found, pts = cv2.findChessboardCornersSB(img, (9, 6), flags=_SB)
-    assert found and len(pts) == 54
     grid = spec.object_points()[:, :2] / spec.pitch_m
-    assert "no board square beyond" in grid_problem(img, pts.reshape(-1, 2), grid, 9, 6, True)
-    wrong = find_target(img, spec)
-    assert wrong.points is None and wrong.reason.startswith("not a 9 x 6 board: ")
+    fooled = 0
+    for path in sorted(example.glob("L*.png"), reverse=True):  # the last views fool it
+        img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+        right = find_target(img, TargetSpec("chessboard", 8, 6, 0.012))
+        assert right.points is not None, (path.name, right.reason)
+        # what OpenCV alone returns on some views: 54 "corners", a column on the plate's edge
+        found, pts = cv2.findChessboardCornersSB(img, (9, 6), flags=_SB)
+        if not found:
+            continue
+        fooled += 1
+        problem = grid_problem(img, pts.reshape(-1, 2), grid, 9, 6, True)
+        assert "no board square beyond" in problem, (path.name, problem)
+        wrong = find_target(img, spec)
+        assert wrong.points is None and wrong.reason.startswith("not a 9 x 6 board: ")
+        break
+    assert fooled == 1
 
 
 def test_uneven_or_bent_grids_are_refused() -> None:
@@ -55,12 +62,15 @@ def test_calibrate_with_a_wrong_board_size_gets_the_hint(
     example: Path, tmp_path: Path, capsys
 ) -> None:
     out = tmp_path / "cellcal.json"
-    code = main(["calibrate", "hand-eye", "--images", str(example), "--poses",
-                 str(example / "poses.csv"), "--stereo", str(example / "stereo.json"),
+    lines = (example / "poses.csv").read_text().splitlines()
+    poses = tmp_path / "poses.csv"  # the first view, then the two the SB detector is fooled by
+    poses.write_text("\n".join([lines[0], lines[1], lines[11], lines[12]]) + "\n")
+    code = main(["calibrate", "hand-eye", "--images", str(example), "--poses", str(poses),
+                 "--stereo", str(example / "stereo.json"),
                  "--cell", "motorcycle_frame", "--cols", "9", "--rows", "6", "--pitch", "0.012",
                  "-o", str(out)])  # fmt: skip
     assert code == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
-    assert "row 1: image L00.png: not a 9 x 6 board" in line
+    assert "row 1: image L00.png: " in line
     assert "is the board size right? --cols 9 --rows 6" in line
     assert not out.exists()

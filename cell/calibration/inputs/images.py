@@ -1,12 +1,13 @@
 """The target's corners in the images of a poses CSV: the observations of an offline calibration.
 
 Every image named by a row is read (8 or 16 bit, colour turned to gray) and the target is
-searched with :func:`measure.target.find_target`. An image that cannot be read, has another
-size than the calibration's, or does not show the whole target is refused with its file and
-row named: a view without the target cannot be used, and guessing which image is wrong is
-left to the user. When the first image lacks only the target, up to :data:`HINT_ROWS` other
-rows' images are searched too: if none shows it, the board size given (``--cols``/``--rows``)
-is the likely mistake and the refusal says so.
+searched with :func:`measure.target.find_target`, its corners put in the board frame's
+order (:func:`cell.calibration.capture.orient_chessboard`: docs/conventions.md). An image that
+cannot be read, has another size than the calibration's, or does not show the whole target is
+refused with its file and row named: a view without the target cannot be used, and guessing
+which image is wrong is left to the user. When the first image lacks only the target, up to
+:data:`HINT_ROWS` other rows' images are searched too: if none shows it, the board size given
+(``--cols``/``--rows``) is the likely mistake and the refusal says so.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from cell.calibration.capture.orient import orient_chessboard
 from cell.calibration.errors import CalibrationDataError, TargetNotFoundError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
 from cell.calibration.inputs.posecsv import PoseRow
@@ -52,7 +54,7 @@ def _corners(
     det = find_target(img, spec, blur_px)
     if det.points is None:
         raise TargetNotFoundError(src, f"image {path.name}: {det.reason}", row)
-    return det.points
+    return orient_chessboard(img, det.points, spec)  # the board frame's order
 
 
 def board_size_hint(spec: TargetSpec) -> str:
