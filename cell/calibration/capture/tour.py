@@ -25,6 +25,7 @@ from cell.calibration.capture.capture import (
 from cell.calibration.errors import CalibrationDataError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
 from cell.calibration.estimate.result import CellCalibration
+from cell.calibration.estimate.soft_views import DroppedView, is_soft, solve_without
 from cell.calibration.estimate.solve import CalibrationResult, SolveOptions, solve_calibration
 from cell.calibration.file.provenance import cell_provenance
 from cell.camera import CameraBackend
@@ -59,6 +60,7 @@ class CellCalibrationRun:
     observations: CalibrationObservations
     result: CalibrationResult
     wall_s: float
+    dropped: tuple[DroppedView, ...] = ()
 
     @property
     def calibration(self) -> CellCalibration:
@@ -96,18 +98,29 @@ def check_calibration_tour(cell: CellConfig, cal_tour: CalibrationTour, where: s
 
 
 def observations_of(
-    captures: TourCaptures, spec: TargetSpec, cameras: Cameras, source: str
-) -> CalibrationObservations:
+    captures: TourCaptures, spec: TargetSpec, cameras: Cameras, source: str,
+    strict: bool = False, dropped: list[DroppedView] | None = None,
+) -> CalibrationObservations:  # fmt: skip
     """The observations of a tour; a view whose left or right image lacks the target is
     refused naming the view and the reason (the tour plans every view with the whole board in
-    both images: a missing board means a wrong target pose, a camera fault or a blurred image,
-    which no calibration should silently absorb)."""
+    both images: a missing board means a wrong target pose or a camera fault, which no
+    calibration should silently absorb). A view failing only a quality check (a blurred image)
+    is appended to ``dropped`` and left out, unless ``strict``
+    (:mod:`cell.calibration.estimate.soft_views`)."""
     views = []
     for v in captures.views:
+        soft = None
         for side, pts, why in (("left", v.corners_left_px, v.reason_left),
                                ("right", v.corners_right_px, v.reason_right)):  # fmt: skip
             if pts is None and (side == "left" or cameras.stereo):
-                raise CalibrationDataError(source, f"{side} image: {why}; nothing written", v.id)
+                if strict or not is_soft(why):
+                    raise CalibrationDataError(source, f"{side} image: {why}; nothing written",
+                                               v.id)  # fmt: skip
+                soft = soft or DroppedView(v.id, f"{side} image: {why}")
+        if soft is not None:
+            if dropped is not None:
+                dropped.append(soft)
+            continue
         right = v.corners_right_px if cameras.stereo else None
         views.append(CalibrationView(v.id, v.corners_left_px, right, q_rad=v.q_rad))
     return CalibrationObservations(tuple(views), spec, cameras, source)
@@ -134,14 +147,17 @@ def run_calibration_tour(
     spec = check_calibration_tour(cell, tour, source)
     captures = TourCapture(tour.tour, client, camera, spec, o.capture, report).run()
     cameras = Cameras.from_stereo(camera.stereo)
-    obs = observations_of(captures, spec, cameras, source)
+    dropped: list[DroppedView] = []
+    obs = observations_of(captures, spec, cameras, source, o.capture.strict, dropped)
+    for d in dropped:
+        report("dropped", {"warning": d.warning(source, len(obs.views))})
     report("solve", {"views": len(obs.views)})
     dh = cell.build_robot().dh
     stereo_source = str(cell.calibration_path() or camera.stereo.source)
     prov = cell_provenance(cell, dh, stereo_source, camera.stereo.to_dict())
-    result = solve_calibration(obs, dh, o.solve, prov)
+    result = solve_without(dropped, source, solve_calibration, obs, dh, o.solve, prov)
     report("done", {"total_s": result.timings["total_s"]})
-    return CellCalibrationRun(captures, obs, result, time.perf_counter() - t0)
+    return CellCalibrationRun(captures, obs, result, time.perf_counter() - t0, tuple(dropped))
 
 
 def calibrate_cell(

@@ -21,6 +21,7 @@ import numpy as np
 from cell.calibration.capture.orient import orient_chessboard
 from cell.calibration.errors import CalibrationDataError, TargetNotFoundError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
+from cell.calibration.estimate.soft_views import DroppedView, is_soft
 from cell.calibration.inputs.posecsv import PoseRow
 from measure.target import MAX_EDGE_WIDTH_PX, TargetSpec, find_target
 
@@ -73,9 +74,13 @@ def observations_from_images(
     cameras: Cameras,
     source: str,
     max_edge_width_px: float = MAX_EDGE_WIDTH_PX,
+    strict: bool = False,
+    dropped: list[DroppedView] | None = None,
 ) -> CalibrationObservations:
     """Detect the target in every row's image(s) and build the observations; an image whose
-    edges are wider than ``max_edge_width_px`` (10-90 % rise) counts as too blurred."""
+    edges are wider than ``max_edge_width_px`` (10-90 % rise) counts as too blurred: its view
+    is appended to ``dropped`` and left out (:mod:`cell.calibration.estimate.soft_views`), or,
+    with ``strict``, refused."""
     folder = Path(images_dir)
     if not folder.is_dir():
         raise CalibrationDataError(str(images_dir), "not a folder of images")
@@ -109,6 +114,10 @@ def observations_from_images(
         try:
             views.append(view(r))
         except TargetNotFoundError as exc:
+            if not strict and is_soft(exc.reason.split(": ", 1)[-1]):
+                if dropped is not None:
+                    dropped.append(DroppedView(r.row, exc.reason))
+                continue
             if views:
                 raise
             others = _spread(rows[k + 1 :], HINT_ROWS)
