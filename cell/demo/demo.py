@@ -146,7 +146,11 @@ def plan_demo(
         cal_job = pool.submit(plan_demo_caltour, caltour_views, seed) if caltour_views else None
         tour = TourPlanner(Options(seed=seed), plan_progress).plan(cell)
         reference = tour_from_dict(ref_job.result(), "reference tour")
+        if cal_job is not None and plan_progress is not None:  # may still be planning
+            plan_progress("calibration tour", int(cal_job.done()), 1)
         caltour = None if cal_job is None else caltour_from_dict(cal_job.result(), "caltour")
+        if cal_job is not None and plan_progress is not None:
+            plan_progress("calibration tour", 1, 1)
     return tour, reference, caltour
 
 
@@ -158,7 +162,9 @@ def run_demo(
     recorder_factory: Callable[..., Any] | None = None,
 ) -> DemoResult:
     """Plan, run and report the built-in cell in ``out_dir`` (created; refused before planning
-    if it is a file or holds a run already)."""
+    if it is a file or holds a run already). ``plan_progress`` gets every stage but the run's
+    holes (``run_progress``): the planner's, the calibration tour's planning, the cell
+    calibration's views and solve, the report."""
     check_new_run_dir(out_dir, resumable=False)
     opts = options or DemoOptions()
     t0 = time.perf_counter()
@@ -173,7 +179,7 @@ def run_demo(
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
         try:
-            cal, run_cal = _calibration(sim, files, opts, caltour)
+            cal, run_cal = _calibration(sim, files, opts, caltour, plan_progress)
             result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder,
                               run_cal)  # fmt: skip
             truth = truth_error(sim.world, files.store.results())
@@ -182,8 +188,14 @@ def run_demo(
             files.store.close()
             if recorder is not None:
                 recorder.close()
+    if plan_progress is not None:  # the report's GD&T Monte Carlo takes seconds
+        plan_progress("report", 0, 2)
     summary = write_report(out_dir, opts.operator)
+    if plan_progress is not None:
+        plan_progress("report", 1, 2)
     datum = datum_truth_error(sim.world, results, Path(out_dir))
+    if plan_progress is not None:
+        plan_progress("report", 2, 2)
     timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
                "calibration_s": cal.seconds if cal else 0.0,
                "total_s": time.perf_counter() - t0}  # fmt: skip
@@ -191,8 +203,9 @@ def run_demo(
 
 
 def _calibration(
-    sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None
-) -> tuple[DemoCalibration | None, RunCalibration | None]:
+    sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> tuple[DemoCalibration | None, RunCalibration | None]:  # fmt: skip
     """Calibrate the simulated cell (``opts.calibrate`` and a realistic cell), write the
     calibration into the run directory and load it back as the run does (checked)."""
     if not (opts.calibrate and opts.realistic):
@@ -200,10 +213,10 @@ def _calibration(
     run_dir = files.store.path.parent
     if caltour is not None:
         cal = calibrate_demo_cell_images(sim, files.cell, caltour, run_dir,
-                                         opts.calibration_speed)  # fmt: skip
+                                         opts.calibration_speed, progress)  # fmt: skip
     else:
         cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
-                                  opts.seed)  # fmt: skip
+                                  opts.seed, progress)  # fmt: skip
     arm = files.cell.build_robot()
     return cal, load_run_calibration(cal.path, files.cell, arm, sim.camera.stereo)
 
