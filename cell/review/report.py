@@ -28,6 +28,7 @@ from typing import Any
 from cell.calibration.use import calibration_summary
 from cell.gdt.report_fields import report_evaluation
 from cell.records.hole_result import HoleResult
+from cell.review.audit_images import kept
 from cell.review.gdt_html import gdt_section
 from cell.review.qif.run_file import write_run_qif
 from cell.review.report_csv import csv_rows, write_csv
@@ -77,6 +78,7 @@ def summary(store: Store) -> dict[str, Any]:
         ),
         "started_at": info["started_at"],
         "finished_at": info["finished_at"],
+        "images": kept(store.path.parent),
     }
 
 
@@ -185,6 +187,11 @@ def format_summary(summ: dict[str, Any]) -> str:
             f"{summ['worst_hole']}, {summ['worst_position_frame']} frame)"
         )
         lines.append(f"worst diameter  {dia * 1e3:.4f} mm")
+    images = summ.get("images")
+    if images:
+        lines.append(f"images kept     {images['pairs']} stereo pairs, "
+                     f"{images['bytes'] / 1e6:.1f} MB lossless PNG in images/ "
+                     "(holecell remeasure; --no-images keeps none)")  # fmt: skip
     if summ.get("max_U_position_m") is not None:
         lines.append(f"largest U (k=2) position ⌀{summ['max_U_position_m'] * 1e6:.1f} µm, "
                      f"diameter {summ['max_U_diameter_m'] * 1e6:.1f} µm")  # fmt: skip
