@@ -117,7 +117,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--no-images",
         action="store_true",
         help="do not keep each stop's stereo pair in RUN_DIR/images (lossless PNG, "
-        "for audit and holecell remeasure; about 2 x 3 MB a stop on the 5 MP head)",
+        "for audit and holecell remeasure; 4.7 MB a stop on the simulated 5 MP head)",
     )
     p.add_argument(
         "--reset",
