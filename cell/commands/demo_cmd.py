@@ -86,6 +86,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
+    p.add_argument("--no-images", action="store_true",
+                   help="do not keep each stop's stereo pair in DIR/images (about 190 MB)")
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
     p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -231,6 +233,7 @@ def run_demo_cmd(args: argparse.Namespace) -> int:
             calibrate=not args.no_calibration,
             calibration_views=args.calibration_views,
             calibration_method=args.calibration_method,
+            keep_images=not args.no_images,
         ),
         _plan_bars(args.quiet),
         _progress(bars),

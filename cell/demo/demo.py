@@ -83,6 +83,7 @@ class DemoOptions:
             the drawn truth above (or, without ``geometry_errors``, no geometric error).
         decision_rule: the run's decision rule.
         operator: the report's operator field.
+        keep_images: keep each stop's pair in the run directory (as ``holecell run``).
     """
 
     warmup_speed: float = 1500.0
@@ -103,6 +104,7 @@ class DemoOptions:
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
     truth: CellTruth | None = None
+    keep_images: bool = True
 
 
 #: the demo's part temperature without a truth file or a figure (degC)
@@ -287,6 +289,7 @@ def _run_sim(
         part_temperature_c=sim.world.part_reading_c(),
         u_part_temperature_K=opts.u_part_temperature_K,
         decision_rule=opts.decision_rule,
+        keep_images=opts.keep_images,
     )
     with ControllerClient(sim.url) as client:
         runner = Runner(files.cell, files.tour, files.store, client, sim.camera, run_opts,
