@@ -86,8 +86,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
-    p.add_argument("--no-images", action="store_true",
-                   help="do not keep each stop's stereo pair in DIR/images (about 190 MB)")
+    p.add_argument(
+        "--no-images",
+        action="store_true",
+        help="do not keep each stop's stereo pair in DIR/images (about 190 MB)",
+    )
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
     p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
