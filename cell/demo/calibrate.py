@@ -145,6 +145,7 @@ def calibrate_demo_cell_images(
         opts = CalibrateCellOptions(
             capture=CaptureSettings(settle_s=0.2 / speed),
             solve=SolveOptions(estimate_intrinsics=True),
+            max_warming_K=float("inf"),  # the demo calibrates its cold arm: reported, not refused
         )  # as the CLI
         with ControllerClient(sim.url) as client:
             run = run_calibration_tour(cell, caltour, client, sim.camera, opts,
@@ -160,5 +161,6 @@ def calibrate_demo_cell_images(
     fixed = tuple(t.name for t in cal.dh_terms if not t.free)
     method = (f"calibration tour of {len(caltour.tour.stops)} views driven on the simulated "
               f"controller ({run.captures.robot_time_s:.0f} s robot time), plate rendered and "
-              f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s")  # fmt: skip
+              f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s"
+              + ("" if run.warming is None else f"; {run.warming.line()}"))  # fmt: skip
     return DemoCalibration(path, cal, seconds, dp, dr, fixed, method)

@@ -66,6 +66,7 @@ class CapturedView:
     corners_right_px: Array | None
     reason_left: str = ""
     reason_right: str = ""
+    temperatures_c: Array | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -187,7 +188,9 @@ class TourCapture(Motion):
         (left, why_left), (right, why_right), dt = future.result()
         wall["detect_s"] += dt
         q = np.asarray(st.q_rad, float).copy()
-        views.append(CapturedView(vid, q, float(st.time_s), left, right, why_left, why_right))
+        temps = np.asarray(st.temperatures_c, float).copy()  # the arm's warming (warming.py)
+        views.append(CapturedView(vid, q, float(st.time_s), left, right, why_left, why_right,
+                                  temps))  # fmt: skip
         self.progress("view", {"k": len(views) - 1, "n": n, "id": vid,
                                "left": left is not None, "right": right is not None})  # fmt: skip
 

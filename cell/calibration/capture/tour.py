@@ -14,7 +14,7 @@ refuses the file. :func:`calibrate_cell` returns just the calibration.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from cell.calibration.capture.capture import (
     CaptureSettings,
@@ -22,6 +22,7 @@ from cell.calibration.capture.capture import (
     TourCapture,
     TourCaptures,
 )
+from cell.calibration.capture.warming import MAX_K, TourWarming, check_warming, tour_warming
 from cell.calibration.errors import CalibrationDataError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
 from cell.calibration.estimate.result import CellCalibration
@@ -48,6 +49,7 @@ class CalibrateCellOptions:
 
     capture: CaptureSettings = field(default_factory=CaptureSettings)
     solve: SolveOptions = field(default_factory=lambda: SolveOptions(estimate_intrinsics=True))
+    max_warming_K: float = MAX_K  # noqa: N815 (unit suffix): cell.calibration.capture.warming
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +63,7 @@ class CellCalibrationRun:
     result: CalibrationResult
     wall_s: float
     dropped: tuple[DroppedView, ...] = ()
+    warming: TourWarming | None = None
 
     @property
     def calibration(self) -> CellCalibration:
@@ -146,6 +149,11 @@ def run_calibration_tour(
     t0 = time.perf_counter()
     spec = check_calibration_tour(cell, tour, source)
     captures = TourCapture(tour.tour, client, camera, spec, o.capture, report).run()
+    warming = tour_warming([v.temperatures_c for v in captures.views],
+                           [v.time_s for v in captures.views])  # fmt: skip
+    warn = check_warming(warming, o.max_warming_K, source)  # refuses past the limit
+    if warming is not None:
+        report("warming", {"line": warning_or(warn, warming)})
     cameras = Cameras.from_stereo(camera.stereo)
     dropped: list[DroppedView] = []
     obs = observations_of(captures, spec, cameras, source, o.capture.strict, dropped)
@@ -156,8 +164,17 @@ def run_calibration_tour(
     stereo_source = str(cell.calibration_path() or camera.stereo.source)
     prov = cell_provenance(cell, dh, stereo_source, camera.stereo.to_dict())
     result = solve_without(dropped, source, solve_calibration, obs, dh, o.solve, prov)
+    if warming is not None:  # kept with the calibration
+        cal = replace(result.calibration, notes=(*result.calibration.notes, warming.line()))
+        result = replace(result, calibration=cal)
     report("done", {"total_s": result.timings["total_s"]})
-    return CellCalibrationRun(captures, obs, result, time.perf_counter() - t0, tuple(dropped))
+    return CellCalibrationRun(captures, obs, result, time.perf_counter() - t0, tuple(dropped),
+                              warming)  # fmt: skip
+
+
+def warning_or(warn: str, warming: TourWarming) -> str:
+    """The warning when there is one, else the plain report line."""
+    return warn or warming.line()
 
 
 def calibrate_cell(
