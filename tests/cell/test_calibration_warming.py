@@ -59,7 +59,9 @@ def test_a_cold_arm_is_reported_and_refused_past_the_limit(
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert "arm warming during the tour: " in line and "over the 0.2 K limit" in line
     assert not out.exists()
-    assert _calibrate(small_cell, caltour, out) == 0  # the default limit (1 K): reported
+    # within the limit (set wide: the simulated time a tour takes grows with the machine's
+    # load): calibrated, the warming reported and kept
+    assert _calibrate(small_cell, caltour, out, "--max-warming-k", "5") == 0
     assert "arm warming during the tour: " in capsys.readouterr().out
     notes = load_calibration(out).notes
     assert any(n.startswith("arm warming during the tour: ") for n in notes)
