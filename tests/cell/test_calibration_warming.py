@@ -55,9 +55,10 @@ def test_a_cold_arm_is_reported_and_refused_past_the_limit(
                  "geometric", "--quiet", "-o", str(caltour)]) == 0  # fmt: skip
     capsys.readouterr()
     out = tmp_path / "cellcal.json"
-    assert _calibrate(small_cell, caltour, out, "--max-warming-k", "0.2") == 2
+    # at least the planned 13 s of robot time from cold: over 0.1 K on the fastest sensor
+    assert _calibrate(small_cell, caltour, out, "--max-warming-k", "0.05") == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
-    assert "arm warming during the tour: " in line and "over the 0.2 K limit" in line
+    assert "arm warming during the tour: " in line and "over the 0.05 K limit" in line
     assert not out.exists()
     # within the limit (set wide: the simulated time a tour takes grows with the machine's
     # load): calibrated, the warming reported and kept
