@@ -28,9 +28,10 @@ ROOT = Path(__file__).resolve().parents[2]
 def _start_sim(cell: Path, log: Path) -> tuple[subprocess.Popen, str, str]:
     """``holecell sim CELL --transport socket`` in its own process; its two URLs."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    # an arm that has run for an hour: the calibration refuses one warming up by over 1 K
+    # an arm that has run for two hours: the calibration refuses one warming up by over 1 K
+    # (the tour's simulated time grows with the machine's load: 0.3 K over 20 min at 2 h)
     argv = [sys.executable, "-m", "cell.cli", "sim", str(cell), "--transport", "socket",
-            "--speed", "20", "--drift-offset-s", "3600", "--duration-s", "600"]  # fmt: skip
+            "--speed", "20", "--drift-offset-s", "7200", "--duration-s", "600"]  # fmt: skip
     out = log.open("w")
     proc = subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT, env=env, cwd=ROOT)
     urls: dict[str, str] = {}
