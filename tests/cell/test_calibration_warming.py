@@ -33,6 +33,9 @@ def test_the_warming_is_the_largest_sensor_change() -> None:
         check_warming(w, 0.5, "tour")
     flat = tour_warming([np.array([20.0])] * 3, [0.0, 1.0, 2.0])
     assert check_warming(flat, MAX_K, "tour") == ""
+    small = tour_warming([np.array([20.0]), np.array([20.1])], [0.0, 1.0])
+    with pytest.raises(CalibrationDataError):  # a limit below the warning level still holds
+        check_warming(small, 0.05, "tour")
 
 
 def _calibrate(sc: SmallCell, caltour: Path, out: Path, *extra: str) -> int:

@@ -59,11 +59,13 @@ def tour_warming(temps_c: list[np.ndarray | None], times_s: list[float]) -> Tour
 def check_warming(w: TourWarming | None, max_K: float, source: str) -> str:
     """The warning for a warming past :data:`WARN_K` ("" below it); refuses one past
     ``max_K`` (:class:`CalibrationDataError`, one line)."""
-    if w is None or w.change_K <= WARN_K:
+    if w is None:
         return ""
     if w.change_K > max_K:
         raise CalibrationDataError(
             source, f"{w.line()}, over the {max_K:g} K limit: the arm's growth would be read as "
             "D-H errors; warm the arm up (or wait for steady readings) and run the tour again, "
             "or raise --max-warming-k; nothing written")  # fmt: skip
+    if w.change_K <= WARN_K:
+        return ""
     return f"warning: {w.line()}, over {WARN_K:g} K: the D-H lengths absorb part of the growth"
