@@ -7,6 +7,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from measure.target_grid import grid_problem
+
 TARGET_KINDS = ("chessboard", "circles")
 
 
@@ -110,7 +112,9 @@ def find_target(
     gray: np.ndarray, spec: TargetSpec, max_edge_width_px: float = MAX_EDGE_WIDTH_PX
 ) -> TargetDetection:
     """Find the target with each detector in turn (:data:`CHESSBOARD_DETECTORS`), then check
-    the corner count and the sharpness of the image (edges up to ``max_edge_width_px``)."""
+    the corner count, that the corners form the board's grid (:mod:`measure.target_grid`: a
+    board size given wrong) and the sharpness of the image (edges up to
+    ``max_edge_width_px``)."""
     img = to_gray8(gray)
     n = spec.cols * spec.rows
     if spec.kind == "chessboard":
@@ -122,6 +126,10 @@ def find_target(
     if len(pts) < n:
         return TargetDetection(None, f"too few corners ({len(pts)} of {n})", detector)
     pts = pts.reshape(-1, 2).astype(np.float32)
+    grid = spec.object_points()[:, :2] / spec.pitch_m
+    wrong = grid_problem(img, pts, grid, spec.cols, spec.rows, spec.kind == "chessboard")
+    if wrong:
+        return TargetDetection(None, f"not a {spec.cols} x {spec.rows} board: {wrong}", detector)
     if spec.kind == "chessboard":
         width = float(cv2.estimateChessboardSharpness(img, spec.pattern_size, pts)[0][0])
     else:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 DESCRIPTION = (
@@ -61,6 +62,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "calibration as exact (default: estimate their corrections with the rest, "
         "marginalised; docs/calibration.md)",
     )  # fmt: skip
+    p.add_argument(
+        "--strict", action="store_true",
+        help="refuse the whole tour when one image fails a quality check (default: drop that "
+        "view with a warning and go on if the rest still determines the calibration)",
+    )  # fmt: skip
+    p.add_argument(
+        "--max-warming-k", type=float, default=1.0, metavar="K",
+        help="refuse the calibration when an arm temperature sensor changed by more than this "
+        "over the tour (K; default %(default)s; warned over 0.3 K): a warming arm's growth is "
+        "read as D-H errors (docs/calibration.md, 'A cold start')",
+    )  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)
 
@@ -76,7 +88,12 @@ def _check_output(out: Path) -> None:
 
 def _progress(quiet: bool):
     def show(event: str, data: dict) -> None:
-        if event == "view":
+        if event == "dropped":
+            print(data["warning"], file=sys.stderr, flush=True)
+        elif event == "warming":
+            print(data["line"], file=sys.stderr if data["line"].startswith("warning") else
+                  sys.stdout, flush=True)  # fmt: skip
+        elif event == "view":
             seen = "" if data["left"] and data["right"] else "  target NOT found"
             print(f"  view {data['k'] + 1}/{data['n']} {data['id']}{seen}", flush=True)
         elif event == "solve":
@@ -120,7 +137,10 @@ def run(args: argparse.Namespace) -> int:
         source = f"the planned calibration tour ({args.views} views)"
     check_calibration_tour(cell, tour, source)  # before the arm moves
     options = CalibrateCellOptions(
-        capture=CaptureSettings(settle_s=args.settle_s, max_edge_width_px=args.max_edge_width),
+        capture=CaptureSettings(
+            settle_s=args.settle_s, max_edge_width_px=args.max_edge_width, strict=args.strict
+        ),
+        max_warming_K=args.max_warming_k,
         solve=replace(
             SolveOptions(),
             estimate_kinematics=not args.no_kinematics,
@@ -142,6 +162,11 @@ def run(args: argparse.Namespace) -> int:
         client.close()
         if camera is not None:
             camera.close()
+    if args.quiet:  # the warnings were not shown as the tour went (cell.calibration...soft_views)
+        for d in done.dropped:
+            print(d.warning(source, len(done.observations.views)), file=sys.stderr)
+    if done.warming is not None:
+        print(done.warming.line())
     print_result(done.result)
     cap = done.captures
     print(f"robot time {cap.robot_time_s:.1f} s on the controller clock (planned "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 import numpy as np
 
@@ -65,6 +66,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="take the stereo extrinsics from stereo.json as exact instead of estimating them",
     )
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="refuse the whole set when one image fails a quality check (default: drop that "
+        "view with a warning and go on if the rest still determines the calibration)",
+    )
     p.set_defaults(handler=run)
 
 
@@ -89,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
 
     from cell.calibration.errors import CalibrationDataError
     from cell.calibration.estimate import Cameras, SolveOptions, solve_calibration
+    from cell.calibration.estimate.soft_views import solve_without
     from cell.calibration.file import cell_provenance, save_calibration
     from cell.calibration.inputs import observations_from_images, read_intrinsics, read_pose_csv
     from cell.commands.calibrate_report import print_result
@@ -124,14 +132,17 @@ def run(args: argparse.Namespace) -> int:
         raise CalibrationDataError(
             "--max-edge-width", f"{args.max_edge_width:g} px is not in (0, 50]"
         )
+    dropped: list = []
     obs = observations_from_images(
-        rows, args.images, spec, cameras, args.poses, args.max_edge_width
+        rows, args.images, spec, cameras, args.poses, args.max_edge_width, args.strict, dropped
     )
+    for d in dropped:  # views left out for their quality (cell.calibration.estimate.soft_views)
+        print(d.warning(str(args.poses), len(obs.views)), file=sys.stderr, flush=True)
     opts = SolveOptions(
         estimate_kinematics=not args.no_kinematics, estimate_stereo=not args.fixed_stereo
     )
     prov = cell_provenance(cell, dh, args.stereo or args.intrinsics, content)
-    result = solve_calibration(obs, dh, opts, prov)
+    result = solve_without(dropped, str(args.poses), solve_calibration, obs, dh, opts, prov)
     print_result(result)
     save_calibration(result.calibration, args.output)
     print(f"wrote {args.output}")

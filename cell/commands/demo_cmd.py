@@ -93,6 +93,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--operator", default="", help="name for the report's operator field")
     p.add_argument("--no-record", action="store_true", help="do not write run.rrd")
+    p.add_argument(
+        "--no-images",
+        action="store_true",
+        help="do not keep each stop's stereo pair in DIR/images (about 190 MB)",
+    )
     p.add_argument("--spawn", action="store_true", help="also stream to a new Rerun viewer")
     p.add_argument("--connect", metavar="URL", help="also stream to this Rerun viewer (gRPC)")
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -169,7 +174,7 @@ def format_demo(res: DemoResult) -> str:
     """The summary table (mm and um for people)."""
     s, t, tr, dt = res.summary, res.timings, res.truth, res.datum
     measured, planned = s["holes_measured"], s["holes_planned"]
-    worst = s["worst_position_deviation_m"]
+    worst = s["worst_position_m"]
     rows = [
         ("holes measured", f"{bar(measured, planned, 20)} {measured}/{planned}"),
         ("missing / unmeasurable", f"{s['holes_missing']} / {s['holes_unmeasured']}"),
@@ -178,11 +183,12 @@ def format_demo(res: DemoResult) -> str:
         ("decisions (ISO 14253-1)" if s.get("decision_rule") != "simple" else "decisions (simple)",
          f"{s['holes_conforming']} conformance proven / {s['holes_inconclusive']} inconclusive "
          f"/ {s['holes_nonconforming']} nonconformance proven"),
-        ("largest U (k=2)", f"position {s['max_U_position_m'] * 1e6:.1f} um, diameter "
-                            f"{s['max_U_diameter_m'] * 1e6:.1f} um" if s["max_U_position_m"]
+        ("largest U (k=2)", f"position ⌀{s['max_U_position_m'] * 1e6:.1f} µm, diameter "
+                            f"{s['max_U_diameter_m'] * 1e6:.1f} µm" if s["max_U_position_m"]
                             else "-"),
         ("part temperature", _part(s.get("part"))),
-        ("worst deviation", f"{worst * 1e3:.4f} mm (hole {s['worst_hole']})" if worst else "-"),
+        ("worst position", f"⌀{worst * 1e3:.4f} mm (ISO 1101; hole {s['worst_hole']}, "
+                           f"{s['worst_position_frame']} frame)" if worst else "-"),
         ("cycle time (planned)", f"{res.tour.cycle_time_s:.1f} s"),
         ("position error vs truth", _datum(dt)),
         ("  best fit", _best_fit(dt)),
@@ -264,6 +270,7 @@ def run_demo_cmd(args: argparse.Namespace) -> int:
             calibration_views=args.calibration_views,
             calibration_method=args.calibration_method,
             referencing=not args.no_referencing,
+            keep_images=not args.no_images,
         ),
         _plan_bars(args.quiet),
         _progress(bars),

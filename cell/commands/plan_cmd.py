@@ -41,6 +41,8 @@ class StageBars:
         bar = "#" * round(frac * self.WIDTH)
         elapsed = time.perf_counter() - self.started
         line = f"{stage:<11s} [{bar:<{self.WIDTH}s}] {done}/{total}  {elapsed:5.2f} s"
+        if 0 < done < total:  # at this stage's pace so far
+            line += f"  ETA {elapsed / done * (total - done):4.0f} s"
         if self.tty:
             self.stream.write("\r" + line + ("\n" if final else ""))
         elif final:

@@ -15,7 +15,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         description=(
             "Reads RUN_DIR/results.sqlite (never modifies it) and writes RUN_DIR/report.json "
             "(summary, every hole, every event; SI units) and RUN_DIR/report.csv (one row per "
-            "hole: nominal and measured centre, deviation, diameter, pass, uncertainty) and "
+            "characteristic, as the HTML: value, tolerance, limits, U, decision; m at 0.01 um) and "
             "RUN_DIR/report.html (the inspection protocol: header, hole table with U and the "
             "ISO 14253-1 decision, plots; self-contained) and RUN_DIR/report.qif (QIF 3.0 "
             "results, validated against the vendored QIF schemas; docs/qif.md)."

@@ -38,13 +38,14 @@ class RunBars:
         elif event == "hole":
             self.done += 1
             r: HoleResult = data["result"]
-            dev = (
-                f"{r.position_deviation_m * 1e3:.4f} mm"
+            dev = (  # ISO 1101 position (the zone's diameter), in the fixture frame: the
+                # datum frame is known only when the report evaluates the run
+                f"position ⌀{2 * r.position_deviation_m * 1e3:.4f} mm (fixture frame)"
                 if r.position_deviation_m is not None
                 else r.reason[:40]
             )
             if r.U_position_m is not None:
-                dev += f" U {r.U_position_m * 1e3:.4f} mm {r.decision or ''}"
+                dev += f" U ⌀{2 * r.U_position_m * 1e3:.4f} mm {r.decision or ''}"
             self._draw(f"holes {bar(self.done, self.total)} {self.done}/{self.total}  "
                        f"{r.hole_id:<8} {r.status:<7} {dev}")  # fmt: skip
 

@@ -19,6 +19,7 @@ into it, :func:`cell.calibration.estimate.synthetic.truth_in_gauge`).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -65,19 +66,49 @@ class DemoCalibration:
         return float(np.linalg.norm(self.calibration.T_tool0_camera.sigma_rot_rad))
 
 
+#: a stage's progress: (stage, done, total), as the planner's (cell.commands.plan_cmd.StageBars)
+StageProgress = Callable[[str, int, int], None]
+
+
+def tour_stages(progress: StageProgress | None) -> Callable[[str, dict], None] | None:
+    """The calibration tour's events (:func:`run_calibration_tour`'s ``progress``) as two
+    stages: ``calibration`` (views captured and their target detected, of the tour's) and
+    ``solve`` (the adjustment: 0 of 1, then 1 of 1)."""
+    if progress is None:
+        return None
+
+    def report(event: str, data: dict) -> None:
+        if event == "view":
+            progress("calibration", data["k"] + 1, data["n"])
+        elif event == "solve":
+            progress("solve", 0, 1)
+        elif event == "done":
+            progress("solve", 1, 1)
+
+    return report
+
+
 def calibrate_demo_cell(
-    sim: SimCell, cell: CellConfig, tour: Tour, run_dir: Path, views: int, seed: int
-) -> DemoCalibration:
+    sim: SimCell, cell: CellConfig, tour: Tour, run_dir: Path, views: int, seed: int,
+    progress: StageProgress | None = None,
+) -> DemoCalibration:  # fmt: skip
     """Calibrate the simulated cell of ``sim`` for the hole tour ``tour`` (its joint range)
-    and write ``run_dir/cellcal.json``."""
+    and write ``run_dir/cellcal.json``; ``progress`` gets the ``calibration`` stage (designing
+    the views, then solving)."""
     t0 = time.perf_counter()
+    if progress is not None:
+        progress("calibration", 0, 2)
     geometry = sim.world.true_geometry()
     stereo = sim.camera.stereo
     q_views = design_views(cell, stereo, np.array([s.q for s in tour.stops]), views)
+    if progress is not None:
+        progress("calibration", 1, 2)
     res = simulated_calibration(cell, geometry, stereo, sim.world.truth.repeatability_rp_m,
                                 q_views, seed=seed, true_stereo=sim.camera.true_stereo)  # fmt: skip
     path = Path(run_dir) / RUN_FILENAME
     save_calibration(res.calibration, path)
+    if progress is not None:
+        progress("calibration", 2, 2)
     seconds = time.perf_counter() - t0
     gauge = truth_in_gauge(synthetic_truth(cell, geometry, stereo))
     dp, dr = pose_error(res.calibration.T_tool0_camera.T, gauge.T_tool0_camera)
@@ -108,10 +139,12 @@ def plan_demo_caltour(views: int, seed: int) -> dict:
 
 
 def calibrate_demo_cell_images(
-    sim: SimCell, cell: CellConfig, caltour: CalibrationTour, run_dir: Path, speed: float
-) -> DemoCalibration:
+    sim: SimCell, cell: CellConfig, caltour: CalibrationTour, run_dir: Path, speed: float,
+    progress: StageProgress | None = None,
+) -> DemoCalibration:  # fmt: skip
     """Run ``caltour`` on the simulated cell at ``speed`` (x real time), detect, solve
-    (:func:`cell.calibration.capture.tour.run_calibration_tour`); write ``run_dir/cellcal.json``."""
+    (:func:`cell.calibration.capture.tour.run_calibration_tour`); write ``run_dir/cellcal.json``;
+    ``progress`` gets the stages of :func:`tour_stages`."""
     from cell.calibration.capture import CalibrateCellOptions, CaptureSettings, run_calibration_tour
     from cell.link.client import ControllerClient
 
@@ -121,9 +154,11 @@ def calibrate_demo_cell_images(
         opts = CalibrateCellOptions(
             capture=CaptureSettings(settle_s=0.2 / speed),
             solve=SolveOptions(estimate_intrinsics=True),
+            max_warming_K=float("inf"),  # the demo calibrates its cold arm: reported, not refused
         )  # as the CLI
         with ControllerClient(sim.url) as client:
-            run = run_calibration_tour(cell, caltour, client, sim.camera, opts)
+            run = run_calibration_tour(cell, caltour, client, sim.camera, opts,
+                                       tour_stages(progress))  # fmt: skip
     finally:
         sim.world.clock.set_speed(1.0)
     cal = run.result.calibration
@@ -135,6 +170,7 @@ def calibrate_demo_cell_images(
     fixed = tuple(t.name for t in cal.dh_terms if not t.free)
     method = (f"calibration tour of {len(caltour.tour.stops)} views driven on the simulated "
               f"controller ({run.captures.robot_time_s:.0f} s robot time), plate rendered and "
-              f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s")  # fmt: skip
+              f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s"
+              + ("" if run.warming is None else f"; {run.warming.line()}"))  # fmt: skip
     note = str(caltour.tour.settings.get("plan_cache", ""))
     return DemoCalibration(path, cal, seconds, dp, dr, fixed, method, note)

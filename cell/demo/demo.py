@@ -100,6 +100,7 @@ class DemoOptions:
             the drawn truth above (or, without ``geometry_errors``, no geometric error).
         decision_rule: the run's decision rule.
         operator: the report's operator field.
+        keep_images: keep each stop's pair in the run directory (as ``holecell run``).
     """
 
     warmup_speed: float = 1500.0
@@ -123,6 +124,7 @@ class DemoOptions:
     decision_rule: str = DEFAULT_RULE
     operator: str = ""
     truth: CellTruth | None = None
+    keep_images: bool = True
 
 
 #: the demo's part temperature without a truth file or a figure (degC)
@@ -174,8 +176,12 @@ def plan_demo(
             else TourPlanner(Options(seed=seed), plan_progress)
         ).plan(cell)
         reference = tour_from_dict(ref_job.result(), "reference tour")
+        if cal_job is not None and plan_progress is not None:  # may still be planning
+            plan_progress("calibration tour", int(cal_job.done()), 1)
         caltour = None if cal_job is None else caltour_from_dict(cal_job.result(), "caltour")
         planned = None if survey_job is None else survey_tour_from_dict(survey_job.result())
+        if cal_job is not None and plan_progress is not None:
+            plan_progress("calibration tour", 1, 1)
     return tour, reference, caltour, planned
 
 
@@ -187,7 +193,9 @@ def run_demo(
     recorder_factory: Callable[..., Any] | None = None,
 ) -> DemoResult:
     """Plan, run and report the built-in cell in ``out_dir`` (created; refused before planning
-    if it is a file or holds a run already)."""
+    if it is a file or holds a run already). ``plan_progress`` gets every stage but the run's
+    holes (``run_progress``): the planner's, the calibration tour's planning, the cell
+    calibration's views and solve, the report."""
     check_new_run_dir(out_dir, resumable=False)
     opts = options or DemoOptions()
     t0 = time.perf_counter()
@@ -204,7 +212,7 @@ def run_demo(
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
         try:
-            cal, run_cal = _calibration(sim, files, opts, caltour)
+            cal, run_cal = _calibration(sim, files, opts, caltour, plan_progress)
             surveyed, network = _survey(sim, files, opts, planned)
             result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder,
                               run_cal, network)  # fmt: skip
@@ -214,8 +222,14 @@ def run_demo(
             files.store.close()
             if recorder is not None:
                 recorder.close()
+    if plan_progress is not None:  # the report's GD&T Monte Carlo takes seconds
+        plan_progress("report", 0, 2)
     summary = write_report(out_dir, opts.operator)
+    if plan_progress is not None:
+        plan_progress("report", 1, 2)
     datum = datum_truth_error(sim.world, results, Path(out_dir))
+    if plan_progress is not None:
+        plan_progress("report", 2, 2)
     timings = {"plan_s": t_plan, "run_s": result.timings["run_s"],
                "calibration_s": cal.seconds if cal else 0.0,
                "survey_s": surveyed.seconds if surveyed else 0.0,
@@ -236,8 +250,9 @@ def _survey(
 
 
 def _calibration(
-    sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None
-) -> tuple[DemoCalibration | None, RunCalibration | None]:
+    sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> tuple[DemoCalibration | None, RunCalibration | None]:  # fmt: skip
     """Calibrate the simulated cell (``opts.calibrate`` and a realistic cell), write the
     calibration into the run directory and load it back as the run does (checked)."""
     if not (opts.calibrate and opts.realistic):
@@ -245,10 +260,10 @@ def _calibration(
     run_dir = files.store.path.parent
     if caltour is not None:
         cal = calibrate_demo_cell_images(sim, files.cell, caltour, run_dir,
-                                         opts.calibration_speed)  # fmt: skip
+                                         opts.calibration_speed, progress)  # fmt: skip
     else:
         cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
-                                  opts.seed)  # fmt: skip
+                                  opts.seed, progress)  # fmt: skip
     arm = files.cell.build_robot()
     return cal, load_run_calibration(cal.path, files.cell, arm, sim.camera.stereo)
 
@@ -335,6 +350,7 @@ def _run_sim(
         part_temperature_c=sim.world.part_reading_c(),
         u_part_temperature_K=opts.u_part_temperature_K,
         decision_rule=opts.decision_rule,
+        keep_images=opts.keep_images,
     )
     with ControllerClient(sim.url) as client:
         runner = Runner(files.cell, files.tour, files.store, client, sim.camera, run_opts,

@@ -285,8 +285,9 @@ class _Run:
         }
 
     def hole_deviations(self, align: str, chars: list[dict[str, Any]]) -> dict[str, Any]:
-        """The holes without a position characteristic, in the run's alignment: in-plane
-        deviation (m), its U and the axial deviation, or the reason there is none."""
+        """The holes without a position characteristic, in the run's alignment: the ISO 1101
+        position value (the diameter 2 |d| of the zone about the nominal axis holding the
+        centre, m), its U and the axial deviation, or the reason there is none."""
         with_position = {c["hole_id"] for c in chars if c["kind"] == "position"}
         out: dict[str, Any] = {}
         for h in self.cell.part.holes:
@@ -301,8 +302,8 @@ class _Run:
             d = self.deviation(h.id, align)
             out[h.id] = {
                 "frame": align,
-                "position_deviation_m": float(d["values"][0] / 2),
-                "U_position_m": d["U_m"] / 2,
+                "position_m": float(d["values"][0]),
+                "U_position_m": d["U_m"],
                 "axial_deviation_m": d["fields"]["axial_deviation_m"],
                 "reason": "",
             }

@@ -1,11 +1,12 @@
 """The evaluation into report.json and the summary: the cell a run was made with, the per-hole
-fields readers already know (``position_deviation_m``, ``U_position_m``, ``decision``,
+fields readers already know (``position_m``, ``U_position_m``, ``decision``,
 ``pass``, ``status``) taken from the characteristics, and the summary's counts.
 
-Per hole with a position characteristic, ``position_deviation_m`` is half its value (the
-in-plane distance of the centre from its nominal, in the DRF) and ``U_position_m`` half its
-U; the fixture-frame figure of the run stays in the characteristic as
-``position_deviation_fixture_m``. A hole whose characteristics were not evaluated has no
+One position convention everywhere (ISO 1101): a position is the diameter ⌀ of the zone about
+the nominal axis that holds the centre, 2 × the centre's in-plane distance from its nominal.
+Per hole with a position characteristic, ``position_m`` is its value (in its DRF,
+``position_frame``) and ``U_position_m`` its U; the fixture-frame value of the run stays in the
+characteristic as ``position_fixture_m``. A hole whose characteristics were not evaluated has no
 position deviation, no U and no decision (its reason says why). A cell evaluated in the
 fixture frame keeps every per-hole field of the run as it was.
 """
@@ -59,9 +60,10 @@ def apply_to_rows(ev: Evaluation, rows: list[dict[str, Any]]) -> None:
         if ev.alignment == FIXTURE and all(c["legacy"] for c in chars):
             continue
         other = ev.hole_deviations.get(row["hole_id"])
-        if other is not None and row["position_deviation_m"] is not None:
-            row["position_deviation_m"] = other.get("position_deviation_m")
+        if other is not None and row["position_m"] is not None:
+            row["position_m"] = other.get("position_m")
             row["U_position_m"] = other.get("U_position_m")
+            row["position_frame"] = other["frame"]
             row["axial_deviation_m"] = other.get("axial_deviation_m")
             if other["reason"]:
                 row["reason"] = "; ".join(filter(None, [row["reason"], other["reason"]]))
@@ -72,10 +74,10 @@ def apply_to_rows(ev: Evaluation, rows: list[dict[str, Any]]) -> None:
 def _apply_one(row: dict[str, Any], chars: list[dict[str, Any]]) -> None:
     for c in chars:
         if c["kind"] == "position":
-            c["position_deviation_fixture_m"] = row["position_deviation_m"]
-            half = None if c["value_m"] is None else c["value_m"] / 2.0
-            row["position_deviation_m"] = half
-            row["U_position_m"] = None if c["U_m"] is None else c["U_m"] / 2.0
+            c["position_fixture_m"] = row["position_m"]
+            row["position_m"] = c["value_m"]
+            row["U_position_m"] = c["U_m"]
+            row["position_frame"] = c["drf"]
             row["axial_deviation_m"] = c.get("axial_deviation_m")
     decisions = [c["decision"] for c in chars]
     row["decision"] = hole_decision(decisions)
@@ -105,16 +107,17 @@ def _within(c: dict[str, Any]) -> bool:
 def apply_to_summary(ev: Evaluation, rows: list[dict[str, Any]], summ: dict[str, Any]) -> None:
     """Recount the summary's hole decisions and extremes from the rows; add the
     characteristics' counts and the alignment."""
-    measured = [r for r in rows if r["position_deviation_m"] is not None]
-    worst = max(measured, key=lambda r: r["position_deviation_m"], default=None)
+    measured = [r for r in rows if r["position_m"] is not None]
+    worst = max(measured, key=lambda r: r["position_m"], default=None)
     U = [r["U_position_m"] for r in measured if r["U_position_m"] is not None]
     summ.update({
         "holes_failed": sum(r["pass"] is False for r in rows),
         "holes_conforming": sum(r["decision"] == CONFORMING for r in rows),
         "holes_inconclusive": sum(r["decision"] == INCONCLUSIVE for r in rows),
         "holes_nonconforming": sum(r["decision"] == NONCONFORMING for r in rows),
-        "worst_position_deviation_m": worst["position_deviation_m"] if worst else None,
+        "worst_position_m": worst["position_m"] if worst else None,
         "worst_hole": worst["hole_id"] if worst else None,
+        "worst_position_frame": worst["position_frame"] if worst else None,
         "max_U_position_m": max(U, default=None),
         "alignment": ev.alignment,
         "characteristics": {d: sum(c["decision"] == d for c in ev.characteristics)
@@ -135,8 +138,13 @@ def report_evaluation(info: dict[str, Any], results: list[HoleResult], rows: lis
     apply_to_rows(ev, rows)
     apply_to_summary(ev, rows, summ)
     by_id = {row["hole_id"]: row for row in rows}
-    keys = ("position_deviation_m", "U_position_m", "axial_deviation_m", "decision", "status",
-            "reason")  # fmt: skip
-    out = [replace(r, passed=by_id[r.hole_id]["pass"],
+    keys = ("axial_deviation_m", "decision", "status", "reason")
+    out = [replace(r, passed=by_id[r.hole_id]["pass"], **_radial(by_id[r.hole_id]),
                    **{k: by_id[r.hole_id][k] for k in keys}) for r in results]  # fmt: skip
     return ev, out
+
+
+def _radial(row: dict[str, Any]) -> dict[str, Any]:
+    """A row's position and U (⌀) as a :class:`HoleResult`'s in-plane distance and its U."""
+    half = {k: None if row[k] is None else row[k] / 2.0 for k in ("position_m", "U_position_m")}
+    return {"position_deviation_m": half["position_m"], "U_position_m": half["U_position_m"]}

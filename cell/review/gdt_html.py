@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from cell.review.svg import Axes, frame, line, svg, text, ticks
+from cell.review.svg import Axes, frame, labels, line, svg, text, ticks
 
 LABEL = {"conformance": "conformance proven", "nonconformance": "nonconformance proven",
          "inconclusive": "inconclusive", "not_evaluated": "not evaluated"}  # fmt: skip
@@ -44,9 +44,9 @@ def _pose_text(pose: dict[str, Any] | None) -> tuple[str, str]:
 def _drf_table(fields: dict[str, Any]) -> str:
     head = (
         "<tr><th class='l'>DRF</th><th class='l'>datums</th><th class='l'>status</th>"
-        "<th>origin x / y / z in part (mm)</th><th>U (k=2) (um)</th>"
-        "<th>roll / pitch / yaw in part (deg)</th><th>U rotation (urad)</th>"
-        "<th class='l'>residuals of the datum fits (um)</th><th class='l'>reason</th></tr>"
+        "<th>origin x / y / z in part (mm)</th><th>U (k=2) (µm)</th>"
+        "<th>roll / pitch / yaw in part (deg)</th><th>U rotation (µrad)</th>"
+        "<th class='l'>residuals of the datum fits (µm)</th><th class='l'>reason</th></tr>"
     )
     rows = []
     for d in fields["datum_reference_frames"]:
@@ -85,26 +85,28 @@ def _placement(fields: dict[str, Any]) -> str:
     angle = np.degrees(np.linalg.norm(Rotation.from_quat(T["quat_xyzw"]).as_rotvec()))
     dist = np.linalg.norm(T["xyz"]) * 1e3
     return ("<table id='placement'><tr><th class='l'>the part on its fixture</th>"
-            "<th>x / y / z (mm)</th><th>U (k=2) (um)</th><th>roll / pitch / yaw (deg)</th>"
-            "<th>U (urad)</th><th>offset (mm)</th><th>angle (deg)</th></tr>"
+            "<th>x / y / z (mm)</th><th>U (k=2) (µm)</th><th>roll / pitch / yaw (°)</th>"
+            "<th>U (µrad)</th><th>offset (mm)</th><th>angle (deg)</th></tr>"
             f"<tr><td class='l'>{escape(p['method'])}</td><td>{xyz}</td>"
             f"<td>{' / '.join(_um(v) for v in p['U_xyz_m'])}</td><td>{rpy}</td>"
             f"<td>{' / '.join(f'{v * 1e6:.0f}' for v in p['U_rotation_rad'])}</td>"
             f"<td>{dist:.3f}</td><td>{angle:.4f}</td></tr></table>")  # fmt: skip
 
 
-def _spec(c: dict[str, Any]) -> str:
+def spec_text(c: dict[str, Any]) -> str:
+    """A characteristic's zone (position) or limits (size), as HTML."""
     if c["kind"] == "position":
         mc = "" if c["material_condition"] == "RFS" else f" ({c['material_condition']})"
         ref = " | ".join(c["datums"]) or c["drf"]
         return f"&#8960;{c['zone_diameter_m'] * 1e3:.3f} mm{mc} to {escape(ref)}"
-    return f"{c['upper_m'] * 1e6:+.0f} / {c['lower_m'] * 1e6:+.0f} um"
+    return f"{c['upper_m'] * 1e6:+.0f} / {c['lower_m'] * 1e6:+.0f} µm"
 
 
 def _char_table(fields: dict[str, Any]) -> str:
     head = ("<tr><th class='l'>characteristic</th><th>nominal (mm)</th>"
-            "<th class='l'>zone or limits</th><th>actual (mm)</th><th>deviation (um)</th>"
-            "<th>value (um)</th><th>bonus (um)</th><th>U (um)</th><th class='l'>decision</th>"
+            "<th class='l'>zone or limits</th><th>actual (mm)</th>"
+            "<th>deviation x / y / z in the DRF (µm)</th>"
+            "<th>value (µm)</th><th>bonus (µm)</th><th>U (µm)</th><th class='l'>decision</th>"
             "<th class='l'>reason</th></tr>")  # fmt: skip
     rows = []
     for c in fields["characteristics"]:
@@ -117,7 +119,7 @@ def _char_table(fields: dict[str, Any]) -> str:
         dec = c["decision"]
         rows.append(f'<tr class="char" data-char="{escape(c["id"])}" data-decision="{dec}">'
                     f"<td class='l'>{escape(c['id'])}</td><td>{nom}</td>"
-                    f"<td class='l'>{_spec(c)}</td><td>{act}</td><td>{dev}</td>"
+                    f"<td class='l'>{spec_text(c)}</td><td>{act}</td><td>{dev}</td>"
                     f"<td>{_um(c['value_m']) if pos else ''}</td>"
                     f"<td>{_um(c.get('bonus_m')) if pos else ''}</td>"
                     f"<td class='U'>{_um(c['U_m'])}</td>"
@@ -129,7 +131,7 @@ def _char_table(fields: dict[str, Any]) -> str:
 def _deviation_plot(fields: dict[str, Any]) -> str:
     """In-plane deviations (perpendicular to each hole's axis) of the position
     characteristics at their nominals, in the datum frame seen along its z (the primary
-    datum's normal); arrows 0.5 px per um, coloured by decision."""
+    datum's normal); arrows 0.5 px per µm, coloured by decision."""
     m = [c for c in fields["characteristics"] if c["kind"] == "position" and c["nominal_m"]
          and c["deviation_m"] is not None]  # fmt: skip
     W, H, per_um = 900, 520, 0.5
@@ -148,9 +150,9 @@ def _deviation_plot(fields: dict[str, Any]) -> str:
         d = (d - (d @ a) * a) * 1e6
         body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="2.5" fill="{col}"/>')
         body.append(line(x, y, x + per_um * d[0], y - per_um * d[1], col, 1.6))
-        body.append(text(x + 4, y - 4, c["hole_id"], 8, fill="#555"))
+    body += labels([(ax.x(p[0]), ax.y(p[1])) for p in nom], [c["hole_id"] for c in m])
     body.append(line(W - 190, 30, W - 140, 30, "#000", 1.6))
-    body.append(text(W - 135, 34, "100 um of deviation", 10))
+    body.append(text(W - 135, 34, "100 µm of deviation", 10))
     body.append(text(ax.left + 6, ax.top + 14, "in-plane deviation of each centre in the datum "
                      "frame, seen along the primary datum's normal", 10, fill="#555"))  # fmt: skip
     return svg(W, H, body, "deviation vectors in the datum reference frame")

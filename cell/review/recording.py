@@ -235,7 +235,8 @@ class Recorder:
         if meas is None:
             rec.log("run/event", rr.TextLog(f"{result.hole_id}: {result.reason}", level="WARN"))
             return
-        rec.log("plots/deviation/position", rr.Scalars(result.position_deviation_m * 1e6))
+        # ISO 1101 position: the zone's diameter, 2 x the in-plane distance (fixture frame)
+        rec.log("plots/deviation/position", rr.Scalars(2 * result.position_deviation_m * 1e6))
         rec.log("plots/deviation/diameter", rr.Scalars(result.diameter_deviation_m * 1e6))
         self._budget(result)
         self._images(meas, pair)
@@ -253,16 +254,17 @@ class Recorder:
         if result.U_position_m is None:
             return
         rec = self.rec
-        rec.log("plots/uncertainty/U_position", rr.Scalars(result.U_position_m * 1e6))
+        rec.log("plots/uncertainty/U_position", rr.Scalars(2 * result.U_position_m * 1e6))
         rec.log("plots/uncertainty/U_diameter", rr.Scalars(result.U_diameter_m * 1e6))
         for c in (result.budget or {}).get("components", []):
             rec.log(f"plots/budget/{c['name']}", rr.Scalars(c["u_position_m"] * 1e6))
         level = {"conforming": "INFO", "inconclusive": "WARN", "nonconforming": "ERROR"}
         rec.log("run/decision", rr.TextLog(
-            f"{result.hole_id}: {result.decision or 'no tolerance'} (deviation "
-            f"{result.position_deviation_m * 1e6:.1f} um +- {result.U_position_m * 1e6:.1f} um, "
-            f"diameter {result.diameter_deviation_m * 1e6:+.1f} um +- "
-            f"{result.U_diameter_m * 1e6:.1f} um, k = 2)",
+            f"{result.hole_id}: {result.decision or 'no tolerance'} (position ⌀"
+            f"{2 * result.position_deviation_m * 1e6:.1f} µm ± {2 * result.U_position_m * 1e6:.1f}"
+            " µm in the fixture frame, "
+            f"diameter {result.diameter_deviation_m * 1e6:+.1f} µm ± "
+            f"{result.U_diameter_m * 1e6:.1f} µm, k = 2)",
             level=level.get(result.decision or "", "INFO")))  # fmt: skip
         color = {
             "conforming": [46, 125, 50],

@@ -1,23 +1,29 @@
 """``report.json`` and ``report.csv`` of a run directory, from its store.
 
-Files are in SI units (m); the printed summary is for people (mm, um). CSV columns:
-``hole_id, stop, status, nominal_x_m .. nominal_z_m, measured_x_m .. measured_z_m,
-position_deviation_m, nominal_diameter_m, diameter_m, diameter_deviation_m, tolerance_m,
+Files are in SI units (m); the printed summary is for people (mm, µm). report.json's ``holes``
+rows: ``hole_id, stop, status, nominal_x_m .. nominal_z_m, measured_x_m .. measured_z_m,
+position_m, position_frame, nominal_diameter_m, diameter_m, diameter_deviation_m, tolerance_m,
 pass, u_center_m, u_diameter_m, reason, thermal_model_id, axial_deviation_m, U_position_m,
 U_diameter_m, decision, decision_rule`` and one ``u_<component>_position_m`` /
-``u_<component>_diameter_m`` pair per budget component (empty cells where a hole was not
-measured; ``thermal_model_id``: the row of the store's ``thermal_models`` the hole was
-compensated with, empty for the nominal kinematics; ``referenced``: the stop was located
-against the surveyed markers (True), fell back to the arm (False), or the run was not
-referenced (empty); ``reference_markers``: the markers the stop was located by, space-separated).
-``u_center_m`` / ``u_diameter_m`` are the circle fit's own one-sigma uncertainties (kept for
-compatibility); ``U_*`` the expanded (k = 2) uncertainties of the whole budget
-(:mod:`cell.uncertainty.budget`); positions and diameters are at 20 degC.
+``u_<component>_diameter_m`` pair per budget component (None where a hole was not measured;
+``thermal_model_id``: the row of the store's ``thermal_models`` the hole was compensated with,
+None for the nominal kinematics). report.csv: one row per characteristic
+(:mod:`cell.review.report_csv`).
+
+One position convention everywhere (ISO 1101): ``position_m`` is the diameter ⌀ of the zone
+about the nominal axis that holds the centre, 2 × the centre's in-plane distance from its
+nominal, in ``position_frame`` (``fixture``: the cell file's part frame; else a DRF id);
+``U_position_m`` its expanded uncertainty, the ``u_<component>_position_m`` the in-plane
+distance's. ``u_center_m`` / ``u_diameter_m`` are the circle fit's own one-sigma uncertainties
+(kept for compatibility); ``U_*`` the expanded (k = 2) uncertainties of the whole budget
+(:mod:`cell.uncertainty.budget`); positions and diameters are at 20 °C.
+``referenced`` (report.json, report.csv): the stop was located against the surveyed markers
+(True), fell back to the arm (False), or the run was not referenced (None, empty);
+``reference_markers``: the markers the stop was located by, space-separated.
 """
 
 from __future__ import annotations
 
-import csv
 import json
 from pathlib import Path
 from typing import Any
@@ -26,25 +32,16 @@ from cell.calibration.use import calibration_summary
 from cell.gdt.report_fields import report_evaluation
 from cell.records.hole_result import HoleResult
 from cell.referencing.markersfile import MARKERS_FILENAME
+from cell.review.audit_images import kept
 from cell.review.gdt_html import gdt_section
 from cell.review.qif.run_file import write_run_qif
 from cell.review.referencing_html import referencing_section
+from cell.review.report_csv import csv_rows, write_csv
 from cell.review.report_html import render_html
 from cell.review.store import Store
 from cell.uncertainty.budget import COMPONENTS
 from cell.uncertainty.decision import CONFORMING, INCONCLUSIVE, NONCONFORMING
 from robots.files import write_text_atomic
-
-CSV_COLUMNS = (
-    "hole_id", "stop", "status",
-    "nominal_x_m", "nominal_y_m", "nominal_z_m",
-    "measured_x_m", "measured_y_m", "measured_z_m",
-    "position_deviation_m", "nominal_diameter_m", "diameter_m", "diameter_deviation_m",
-    "tolerance_m", "pass", "u_center_m", "u_diameter_m", "reason", "thermal_model_id",
-    "axial_deviation_m", "U_position_m", "U_diameter_m", "decision", "decision_rule",
-    "referenced", "reference_markers",
-    *(f"u_{c}_{q}_m" for c in COMPONENTS for q in ("position", "diameter")),
-)  # fmt: skip
 
 
 def summary(store: Store) -> dict[str, Any]:
@@ -54,6 +51,7 @@ def summary(store: Store) -> dict[str, Any]:
     planned = store.planned()
     measured = [r for r in results if r.measured]
     worst = max(measured, key=lambda r: r.position_deviation_m, default=None)
+    U_pos = [r.U_position_m for r in measured if r.U_position_m is not None]
     return {
         "cell": info["cell_name"],
         "cell_sha256": info["cell_sha256"],
@@ -74,19 +72,19 @@ def summary(store: Store) -> dict[str, Any]:
         "part": store.part_state(),
         **_referencing_counts(results),
         "calibration": calibration_summary(store.path.parent),
-        "max_U_position_m": max(
-            (r.U_position_m for r in measured if r.U_position_m is not None), default=None
-        ),
+        "max_U_position_m": _twice(max(U_pos, default=None)),
         "max_U_diameter_m": max(
             (r.U_diameter_m for r in measured if r.U_diameter_m is not None), default=None
         ),
-        "worst_position_deviation_m": worst.position_deviation_m if worst else None,
+        "worst_position_m": _twice(worst.position_deviation_m) if worst else None,
         "worst_hole": worst.hole_id if worst else None,
+        "worst_position_frame": "fixture" if worst else None,
         "worst_diameter_deviation_m": max(
             (abs(r.diameter_deviation_m) for r in measured), default=None
         ),
         "started_at": info["started_at"],
         "finished_at": info["finished_at"],
+        "images": kept(store.path.parent),
     }
 
 
@@ -112,7 +110,8 @@ def _row(r: HoleResult) -> dict[str, Any]:
         "status": r.status,
         "nominal_x_m": nom[0], "nominal_y_m": nom[1], "nominal_z_m": nom[2],
         "measured_x_m": meas[0], "measured_y_m": meas[1], "measured_z_m": meas[2],
-        "position_deviation_m": r.position_deviation_m,
+        "position_m": _twice(r.position_deviation_m),
+        "position_frame": "fixture" if r.position_deviation_m is not None else None,
         "nominal_diameter_m": r.nominal_diameter_m,
         "diameter_m": r.diameter_m,
         "diameter_deviation_m": r.diameter_deviation_m,
@@ -123,7 +122,7 @@ def _row(r: HoleResult) -> dict[str, Any]:
         "reason": r.reason,
         "thermal_model_id": r.thermal_model_id,
         "axial_deviation_m": r.axial_deviation_m,
-        "U_position_m": r.U_position_m,
+        "U_position_m": _twice(r.U_position_m),
         "U_diameter_m": r.U_diameter_m,
         "decision": r.decision,
         "decision_rule": r.decision_rule,
@@ -139,6 +138,11 @@ def _referencing(r: HoleResult) -> dict[str, Any]:
         return {"referenced": None, "reference_markers": None}
     return {"referenced": bool(ref.get("referenced")),
             "reference_markers": " ".join(ref.get("markers", [])) or None}  # fmt: skip
+
+
+def _twice(v: float | None) -> float | None:
+    """An in-plane distance as the ISO 1101 position value (⌀ of the zone, m)."""
+    return None if v is None else 2.0 * v
 
 
 def _components(r: HoleResult) -> dict[str, Any]:
@@ -168,16 +172,13 @@ def write_report(run_dir: str | Path, operator: str = "") -> dict[str, Any]:
     gdt, results = report_evaluation(info, results, rows, summ)  # cell.gdt, docs/gdt.md
     html = render_html(summ, info, results, planned, operator, reference,
                        gdt_section(gdt.fields()), gdt.alignment == "fixture",
+                       gdt.characteristics,
                        referencing_section(results, _markers_doc(run_dir)))  # fmt: skip
     write_text_atomic(run_dir / "report.html", html)
     doc = {"format": "holecell.report", "version": 1, "summary": summ, "holes": rows,
            "events": events, **gdt.fields()}  # fmt: skip
     (run_dir / "report.json").write_text(json.dumps(doc, indent=1))
-    with (run_dir / "report.csv").open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=CSV_COLUMNS)
-        w.writeheader()
-        for row in rows:
-            w.writerow({k: ("" if v is None else v) for k, v in row.items()})
+    write_csv(run_dir / "report.csv", csv_rows(rows, gdt.characteristics, summ["decision_rule"]))
     write_run_qif(doc, run_dir, info, results)  # QIF 3.0 results (cell.review.qif)
     return summ
 
@@ -195,7 +196,7 @@ def _markers_doc(run_dir: Path) -> dict[str, Any] | None:
 
 def format_summary(summ: dict[str, Any]) -> str:
     """The human summary (mm, um)."""
-    worst = summ["worst_position_deviation_m"]
+    worst = summ["worst_position_m"]
     dia = summ["worst_diameter_deviation_m"]
     lines = [
         f"cell            {summ['cell']} ({summ['robot_model']})",
@@ -226,9 +227,17 @@ def format_summary(summ: dict[str, Any]) -> str:
                      f"+- {part['u_temperature_K']:.2f} K ({part['source']}), {part['material']}; "
                      "results at 20 degC")  # fmt: skip
     if worst is not None:
-        lines.append(f"worst position  {worst * 1e3:.4f} mm (hole {summ['worst_hole']})")
+        lines.append(
+            f"worst position  ⌀{worst * 1e3:.4f} mm (ISO 1101; hole "
+            f"{summ['worst_hole']}, {summ['worst_position_frame']} frame)"
+        )
         lines.append(f"worst diameter  {dia * 1e3:.4f} mm")
+    images = summ.get("images")
+    if images:
+        lines.append(f"images kept     {images['pairs']} stereo pairs, "
+                     f"{images['bytes'] / 1e6:.1f} MB lossless PNG in images/ "
+                     "(holecell remeasure; --no-images keeps none)")  # fmt: skip
     if summ.get("max_U_position_m") is not None:
-        lines.append(f"largest U (k=2) position {summ['max_U_position_m'] * 1e6:.1f} um, "
-                     f"diameter {summ['max_U_diameter_m'] * 1e6:.1f} um")  # fmt: skip
+        lines.append(f"largest U (k=2) position ⌀{summ['max_U_position_m'] * 1e6:.1f} µm, "
+                     f"diameter {summ['max_U_diameter_m'] * 1e6:.1f} µm")  # fmt: skip
     return "\n".join(lines)

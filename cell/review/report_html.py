@@ -1,11 +1,11 @@
 """``report.html``: the inspection protocol of a run, one self-contained file.
 
 A CMM-style report: a header (cell, part, run, dates, operator, temperatures, decision rule),
-the counts, one table row per hole (nominal, actual, deviation, U, tolerance, decision), three
-plots as inline SVG (deviation vectors over the part, deviations against the tolerance with U,
-the thermal state over the run) and the uncertainty budget. No script, no stylesheet or font
-from the network: it opens and prints anywhere. Lengths shown in mm and um (the headers say
-which); positions and diameters at 20 degC.
+the counts, one table row per hole (nominal, actual, position ⌀, U, tolerance, decision), plots
+as inline SVG (deviation vectors over the part, each characteristic against its tolerance with
+U: :mod:`cell.review.tolerance_charts`, the thermal state over the run) and the uncertainty
+budget. No script, no stylesheet or font from the network: it opens and prints anywhere.
+Lengths shown in mm and µm (the headers say which); positions and diameters at 20 °C.
 
 The hole table is ``<table id="holes">`` with one ``<tr class="hole" data-hole=ID
 data-decision=...>`` per planned hole (a test reads it back with :mod:`html.parser`).
@@ -21,7 +21,9 @@ import numpy as np
 
 from cell.calibration.use import describe
 from cell.records.hole_result import HoleResult
-from cell.review.svg import COLORS, SERIES, Axes, frame, line, svg, text, ticks
+from cell.review.gdt_html import spec_text
+from cell.review.svg import COLORS, SERIES, Axes, frame, labels, line, svg, text, ticks
+from cell.review.tolerance_charts import items, tolerance_chart
 from cell.uncertainty.budget import COMPONENTS
 
 DECISION_LABEL = {"conforming": "conformance proven", "inconclusive": "inconclusive",
@@ -50,11 +52,11 @@ def _header(summ: dict[str, Any], info: dict[str, Any], operator: str,
             results: list[HoleResult]) -> str:  # fmt: skip
     part = summ.get("part") or {}
     temps = np.array([r.temperatures_c for r in results if r.temperatures_c], float)
-    arm = (f"{temps.min():.1f} .. {temps.max():.1f} degC over {temps.shape[1]} sensors"
+    arm = (f"{temps.min():.1f} .. {temps.max():.1f} °C over {temps.shape[1]} sensors"
            if temps.size else "-")  # fmt: skip
-    ptemp = (f"{part['temperature_c']:.2f} degC +- {part['u_temperature_K']:.2f} K "
+    ptemp = (f"{part['temperature_c']:.2f} °C ± {part['u_temperature_K']:.2f} K "
              f"({part['source']}); {part['material']}, alpha {part['alpha_per_K'] * 1e6:.2f} "
-             f"+- {part['u_alpha_per_K'] * 1e6:.2f} ppm/K" if part else "-")  # fmt: skip
+             f"± {part['u_alpha_per_K'] * 1e6:.2f} ppm/K" if part else "-")  # fmt: skip
     rows = [("Cell", f"{summ['cell']} (SHA-256 {summ['cell_sha256'][:12]})"),
             ("Part", f"{len(results)} of {summ['holes_planned']} holes stored"),
             ("Robot", summ["robot_model"]), ("Run", info.get("run_dir", "")),
@@ -64,8 +66,8 @@ def _header(summ: dict[str, Any], info: dict[str, Any], operator: str,
             ("Operator", operator or "_" * 28 + "   signature " + "_" * 20),
             ("Part temperature", ptemp), ("Arm temperatures", arm),
             ("Cell calibration", describe(summ.get("calibration"))),
-            ("Reference temperature", "20 degC (ISO 1): every position and diameter is reported "
-                                      "at 20 degC"),
+            ("Reference temperature", "20 °C (ISO 1): every position and diameter is reported "
+                                      "at 20 °C"),
             ("Decision rule", (summ.get("decision_rule") or "-") + " (ISO 14253-1: conformance "
              "proven when |deviation| + U <= tolerance; U expanded, k = 2)")]  # fmt: skip
     body = "".join(f"<tr><td><b>{escape(k)}</b></td><td>{escape(str(v))}</td></tr>"
@@ -85,11 +87,26 @@ def _counts(summ: dict[str, Any]) -> str:
     ) + "</p>"  # fmt: skip
 
 
-def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]]) -> str:
+def _tolerances(chars: list[dict[str, Any]], results: list[HoleResult]) -> dict[str, str]:
+    """The tolerance column per hole: its characteristics' zones and limits (the old single
+    ``tolerance`` t as a zone of ⌀2t and a size of ±t when there are none)."""
+    out: dict[str, list[str]] = {}
+    for c in chars:
+        out.setdefault(c["hole_id"], []).append(spec_text(c))
+    for r in results:
+        if r.hole_id not in out and r.tolerance_m is not None:
+            t = r.tolerance_m
+            out[r.hole_id] = [f"&#8960;{2 * t * 1e3:.3f} mm", f"±{t * 1e6:.0f} µm"]
+    return {k: "; ".join(v) for k, v in out.items()}
+
+
+def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]],
+                tolerance: dict[str, str]) -> str:  # fmt: skip
     head = ("<tr><th class='l'>hole</th><th>stop</th><th>nominal x / y / z (mm)</th>"
-            "<th>actual x / y / z (mm)</th><th>position dev. (um)</th><th>U pos. (um)</th>"
-            "<th>nominal dia. (mm)</th><th>actual dia. (mm)</th><th>dia. dev. (um)</th>"
-            "<th>U dia. (um)</th><th>tolerance (um)</th><th class='l'>decision</th>"
+            "<th>actual x / y / z (mm)</th><th>position &#8960; (µm)</th>"
+            "<th>U pos. &#8960; (µm)</th>"
+            "<th>nominal dia. (mm)</th><th>actual dia. (mm)</th><th>dia. dev. (µm)</th>"
+            "<th>U dia. (µm)</th><th class='l'>tolerance</th><th class='l'>decision</th>"
             "<th class='l'>status</th></tr>")  # fmt: skip
     by_id = {r.hole_id: r for r in results}
     rows = []
@@ -100,7 +117,8 @@ def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]])
         if r is None:
             rows.append(f'<tr class="hole" data-hole="{escape(hole_id)}" data-decision="">'
                         f"<td class='l'>{escape(hole_id)}</td><td>{stop}</td><td>{nom_s}</td>"
-                        + "<td></td>" * 9 + "<td class='l'>not reached</td></tr>")  # fmt: skip
+                        + "<td></td>" * 7 + f"<td class='l'>{tolerance.get(hole_id, '')}</td>"
+                        + "<td></td><td class='l'>not reached</td></tr>")  # fmt: skip
             continue
         act = " / ".join(f"{v * 1e3:.3f}" for v in r.center_part_m) if r.center_part_m else ""
         dec = r.decision
@@ -109,12 +127,12 @@ def _hole_table(results: list[HoleResult], planned: list[tuple[str, int, dict]])
         rows.append(
             f'<tr class="hole" data-hole="{escape(r.hole_id)}" data-decision="{cls}">'
             f"<td class='l'>{escape(r.hole_id)}</td><td>{r.stop_index}</td><td>{nom_s}</td>"
-            f"<td>{act}</td><td>{_fmt(r.position_deviation_m, 1e6, 1)}</td>"
-            f"<td class='U'>{_fmt(r.U_position_m, 1e6, 1)}</td>"
+            f"<td>{act}</td><td>{_fmt(r.position_deviation_m, 2e6, 1)}</td>"
+            f"<td class='U'>{_fmt(r.U_position_m, 2e6, 1)}</td>"
             f"<td>{_fmt(r.nominal_diameter_m, 1e3, 3)}</td><td>{_fmt(r.diameter_m, 1e3, 4)}</td>"
             f"<td>{_fmt(r.diameter_deviation_m, 1e6, 1)}</td>"
             f"<td class='U'>{_fmt(r.U_diameter_m, 1e6, 1)}</td>"
-            f"<td>{_fmt(r.tolerance_m, 1e6, 0)}</td>"
+            f"<td class='l'>{tolerance.get(r.hole_id, '')}</td>"
             f"<td class='l decision {cls}'>{DECISION_LABEL.get(dec, dec)}</td>"
             f"<td class='l'>{escape(status)}</td></tr>")  # fmt: skip
     return f'<table id="holes">{head}{"".join(rows)}</table>'
@@ -139,48 +157,19 @@ def _vector_plot(results: list[HoleResult]) -> str:
     pad = 40.0
     ax = Axes(W, H, (nom[:, 0].min() - pad, nom[:, 0].max() + pad),
               (nom[:, 2].min() - pad, nom[:, 2].max() + pad))  # fmt: skip
-    per_um = 1.0  # arrow length: 1 px per um
+    per_um = 1.0  # arrow length: 1 px per µm
     body = frame(ax, "part x (mm)", "part z (mm)", ticks(*ax.xlim), ticks(*ax.ylim))
     for r, p, d in zip(m, nom, dev, strict=True):
         x, y = ax.x(p[0]), ax.y(p[2])
         c = COLORS.get(r.decision, "#757575")
         body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="3" fill="{c}"/>')
         body.append(line(x, y, x + per_um * d[0], y - per_um * d[2], c, 1.6))
-        body.append(text(x + 4, y - 4, r.hole_id, 8, fill="#555"))
+    body += labels([(ax.x(p[0]), ax.y(p[2])) for p in nom], [r.hole_id for r in m])
     body.append(line(W - 180, 30, W - 130, 30, "#000", 1.6))
-    body.append(text(W - 125, 34, "50 um of deviation", 10))
+    body.append(text(W - 125, 34, "50 µm of deviation", 10))
     body.append(text(ax.left + 6, ax.top + 14, "in-plane deviation of each hole, seen from the "
                      "robot's side (part y toward the viewer)", 10, fill="#555"))  # fmt: skip
     return svg(W, H, body, "deviation vectors over the part (side view, x-z)")
-
-
-def _bar_plot(results: list[HoleResult], key: str, ukey: str, label: str) -> str:
-    """|deviation| per hole with its U as an error bar, and the tolerance."""
-    m = [r for r in results if r.measured and getattr(r, key) is not None]
-    W, row = 900, 13
-    H = 60 + row * max(len(m), 1)
-    if not m:
-        return svg(W, 60, [text(10, 30, "no measured hole")], label)
-    vals = np.array([abs(getattr(r, key)) for r in m]) * 1e6
-    us = np.array([getattr(r, ukey) or 0.0 for r in m]) * 1e6
-    tol = max((r.tolerance_m or 0.0) for r in m) * 1e6
-    hi = max(float((vals + us).max()), tol) * 1.08
-    ax = Axes(W, H, (0.0, hi), (0.0, float(len(m))), margin=(70, 20, 10, 35))
-    body = frame(ax, f"{label} (um)", "", ticks(0.0, hi), [])
-    for i, (r, v, u) in enumerate(zip(m, vals, us, strict=True)):
-        y0, y1 = ax.y(len(m) - i), ax.y(len(m) - i - 1)
-        c = COLORS.get(r.decision, "#757575")
-        yb, hb = y0 + 2, max(y1 - y0 - 4, 1)
-        body.append(f'<rect x="{ax.x(0):.1f}" y="{yb:.1f}" width="{ax.x(v) - ax.x(0):.1f}" '
-                    f'height="{hb:.1f}" fill="{c}" opacity="0.75"/>')  # fmt: skip
-        ym = (y0 + y1) / 2
-        body += [line(ax.x(max(v - u, 0)), ym, ax.x(v + u), ym, "#000", 1.2),
-                 line(ax.x(v + u), ym - 3, ax.x(v + u), ym + 3, "#000", 1.2),
-                 text(ax.left - 4, ym + 3, r.hole_id, 8, "end")]  # fmt: skip
-    if tol > 0:
-        body.append(line(ax.x(tol), ax.top, ax.x(tol), H - ax.bottom, "#c62828", 1.5, "5,3"))
-        body.append(text(ax.x(tol) + 3, ax.top + 10, f"tolerance {tol:g} um", 10, fill="#c62828"))
-    return svg(W, H, body, f"{label} against the tolerance, with U (k = 2)")
 
 
 def _thermal_plot(results: list[HoleResult], reference: list[tuple[float, Any]]) -> str:
@@ -197,7 +186,7 @@ def _thermal_plot(results: list[HoleResult], reference: list[tuple[float, Any]])
     temps = np.array([b for _, b in rows])
     ax = Axes(W, H, (t.min(), t.max() if t.max() > t.min() else t.min() + 1),
               (temps.min() - 0.5, temps.max() + 0.5), margin=(60, 220, 20, 40))  # fmt: skip
-    body = frame(ax, "controller time (min)", "sensor reading (degC)", ticks(*ax.xlim),
+    body = frame(ax, "controller time (min)", "sensor reading (°C)", ticks(*ax.xlim),
                  ticks(*ax.ylim))  # fmt: skip
     if m:
         t0, t1 = min(r.sim_time_s for r in m) / 60.0, max(r.sim_time_s for r in m) / 60.0
@@ -216,7 +205,7 @@ def _thermal_plot(results: list[HoleResult], reference: list[tuple[float, Any]])
     if comp:
         lo, hi = np.min(comp) * 1e6, np.max(comp) * 1e6
         body.append(text(W - 210, 40 + 14 * temps.shape[1],
-                         f"compensation applied: {lo:.0f}..{hi:.0f} um", 10))  # fmt: skip
+                         f"compensation applied: {lo:.0f}..{hi:.0f} µm", 10))  # fmt: skip
     return svg(W, H, body, "thermal state over the run")
 
 
@@ -230,8 +219,8 @@ def _budget_table(results: list[HoleResult]) -> str:
             rows[c["name"]][1].append(c["u_diameter_m"])
             notes[c["name"]] = c["note"]
     head = (
-        "<tr><th class='l'>component</th><th>u position, median / max (um)</th>"
-        "<th>u diameter, median / max (um)</th><th class='l'>source</th></tr>"
+        "<tr><th class='l'>component</th><th>u position (in-plane), median / max (µm)</th>"
+        "<th>u diameter, median / max (µm)</th><th class='l'>source</th></tr>"
     )
     body = []
     for name, (p, d) in rows.items():
@@ -250,30 +239,35 @@ def render_html(summ: dict[str, Any], info: dict[str, Any], results: list[HoleRe
                 planned: list[tuple[str, int, dict]], operator: str = "",
                 reference: list[tuple[float, Any]] | None = None,
                 gdt_html: str = "", fixture_plot: bool = True,
+                characteristics: list[dict[str, Any]] | None = None,
                 referencing_html: str = "") -> str:  # fmt: skip
     """The whole ``report.html`` document; ``reference``: (controller time s, readings degC)
     of the reference-target observations, for the thermal plot; ``gdt_html``: the alignment
     and characteristics (:mod:`cell.review.gdt_html`), after the counts; ``fixture_plot``: draw the
     deviation vectors in the part frame (False when the run is evaluated in a datum frame,
-    whose own plot ``gdt_html`` holds); ``referencing_html``: the marker network and each
-    stop's referencing (:mod:`cell.review.referencing_html`), after the budget."""
+    whose own plot ``gdt_html`` holds); ``characteristics``: report.json's, for the tolerance
+    column and charts (none: the holes' old single tolerance); ``referencing_html``: the marker
+    network and each stop's referencing (:mod:`cell.review.referencing_html`), after the
+    budget."""
+    chars = characteristics or []
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>Inspection report {escape(summ['cell'])}</title><style>{CSS}</style></head><body>",
         f"<h1>Inspection report: {escape(summ['cell'])}</h1>",
         _header(summ, info, operator, results),
         "<h2>Result</h2>", _counts(summ), gdt_html,
-        "<h2>Holes</h2>", _hole_table(results, planned),
-        "<p class='note'>Position deviation: distance of the measured centre from the nominal in "
+        "<h2>Holes</h2>", _hole_table(results, planned, _tolerances(chars, results)),
+        "<p class='note'>Position &#8960; (ISO 1101): the diameter of the zone about the "
+        "nominal axis that holds the measured centre, 2 &#215; its distance from the nominal in "
         "the plane perpendicular to the nominal axis, in the run's alignment (above; the "
         "positions are in the part frame). U: expanded uncertainty (k = 2). Decisions per "
         "ISO 14253-1 on both characteristics.</p>",
         *(["<h2>Deviation vectors over the part</h2>", _vector_plot(results)]
           if fixture_plot else []),
-        "<h2>Position deviation against the tolerance</h2>",
-        _bar_plot(results, "position_deviation_m", "U_position_m", "position deviation"),
+        "<h2>Position &#8960; against the tolerance</h2>",
+        tolerance_chart(items(chars, results, "position"), "position"),
         "<h2>Diameter deviation against the tolerance</h2>",
-        _bar_plot(results, "diameter_deviation_m", "U_diameter_m", "|diameter deviation|"),
+        tolerance_chart(items(chars, results, "diameter"), "diameter"),
         "<h2>Thermal drift over the run</h2>", _thermal_plot(results, reference or []),
         "<h2>Uncertainty budget (standard uncertainties, GUM)</h2>", _budget_table(results),
         referencing_html,

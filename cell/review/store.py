@@ -270,6 +270,13 @@ class Store:
         ).fetchone()
         return None if row is None else (int(row[0]), row[1], row[2])
 
+    def model(self, model_id: int) -> tuple[str, str] | None:
+        """``(source, thermal.json text)`` of the stored model ``model_id``, or None."""
+        row = self._con.execute(
+            "SELECT source, model_json FROM thermal_models WHERE id = ?", (model_id,)
+        ).fetchone()
+        return None if row is None else (row[0], row[1])
+
     def results(self) -> list[HoleResult]:
         """Every stored hole, in stop order."""
         rows = self._con.execute(

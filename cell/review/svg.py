@@ -83,3 +83,42 @@ def ticks(lo: float, hi: float, n: int = 5) -> list[float]:
             break
     first = math.ceil(lo / step) * step
     return [round(first + i * step, 10) for i in range(int((hi - first) / step) + 1)]
+
+
+def text_box(x: float, y: float, s: str, size: int) -> tuple[float, float, float, float]:
+    """The box ``(x0, y0, x1, y1)`` a left-anchored ``text`` at ``x``, ``y`` (its baseline)
+    takes, estimated at 0.6 ``size`` per character."""
+    return (x, y - 0.8 * size, x + 0.6 * size * len(s), y + 0.2 * size)
+
+
+def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def labels(points: Sequence[tuple[float, float]], names: Sequence[str], size: int = 8,
+           fill: str = "#555") -> list[str]:  # fmt: skip
+    """Text labels for the marks at ``points`` (px), each placed beside its mark where it
+    overlaps no label placed before and no mark; when every spot near the mark is taken, a
+    farther one with a leader line. Greedy, in the given order."""
+    marks = [(x - 3, y - 3, x + 3, y + 3) for x, y in points]
+    placed: list[tuple[float, float, float, float]] = []
+    out = []
+    for (x, y), s in zip(points, names, strict=True):
+        w = 0.6 * size * len(s)
+        near = [(4, -4), (4, size + 2), (-4 - w, -4), (-4 - w, size + 2), (-w / 2, -6),
+                (-w / 2, size + 6)]  # fmt: skip
+        far = [(r * dx - (w if dx < 0 else 0), r * dy) for r in (14, 22, 30, 40)
+               for dx, dy in ((1, -1), (1, 1), (-1, -1), (-1, 1), (0, -1), (0, 1))]  # fmt: skip
+        choice, leader = None, False
+        for k, (dx, dy) in enumerate(near + far):
+            box = text_box(x + dx, y + dy, s, size)
+            if not any(_overlap(box, b) for b in placed + marks):
+                choice, leader = (x + dx, y + dy), k >= len(near)
+                break
+        if choice is None:  # crowded beyond the search: the first spot, as before
+            choice = (x + 4, y - 4)
+        placed.append(text_box(*choice, s, size))
+        if leader:
+            out.append(line(x, y, choice[0] + w / 2, choice[1] - 0.3 * size, "#bbb", 0.6))
+        out.append(text(choice[0], choice[1], s, size, fill=fill))
+    return out

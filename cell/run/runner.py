@@ -31,6 +31,7 @@ from cell.link.motion import Motion
 from cell.records.hole_result import HoleResult
 from cell.referencing.detection import detect_pair, label_circles
 from cell.referencing.network import MarkerNetwork
+from cell.review.audit_images import save_pair
 from cell.review.store import Store
 from cell.run.inspect import T_cell_tcp, inspect_hole, uncaptured_hole
 from cell.run.reference import target_of
@@ -73,6 +74,7 @@ class RunOptions:
             stored by the run before a resume, else the cell file's or 20 degC assumed).
         u_part_temperature_K: its standard uncertainty (K; None: 0.2 K, a contact thermometer).
         decision_rule: ``iso14253`` (ISO 14253-1, with the expanded uncertainty) or ``simple``.
+        keep_images: keep each stop's pair in the run directory (:mod:`cell.review.audit_images`).
 
     The reference temperatures of an identified model are the first reference round's readings
     (the rule of ``holecell thermal identify``), not a fixed value.
@@ -86,6 +88,7 @@ class RunOptions:
     part_temperature_c: float | None = None
     u_part_temperature_K: float | None = None  # noqa: N815 (unit suffix)
     decision_rule: str = DEFAULT_RULE
+    keep_images: bool = True
 
 
 @dataclass
@@ -414,6 +417,8 @@ class Runner(Motion):
         result = replace(result, thermal_model_id=self.model_id if self.model else None)
         clock.lap("inspect_s")
         self.store.record_hole(result)
+        if self.options.keep_images:  # for audit and holecell remeasure
+            save_pair(self.store.path.parent, k, stop.hole_id, pair.left, pair.right)
         clock.lap("store_s")
         if self.recorder is not None:
             T = located.resection.T_cell_left if located and located.referenced else T_arm

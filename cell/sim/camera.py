@@ -5,11 +5,14 @@ computes the TRUE camera pose (true base, D-H errors and thermal drift, true hea
 :class:`cell.sim.true_geometry.TrueGeometry`), finds the true hole or reference target in
 front of the head, and renders the pair with :func:`measure.synth.render_hole_pair` (a reference
 target with :func:`measure.synth.render_reference_pair`). A missing hole renders the bare surface.
-With no hole in view and the view axis on the calibration plate (at its true pose), it renders
-the plate with :func:`measure.synth.targets.render_target_pair`. The reference markers in
-front of the head (at their true places, :attr:`cell.sim.world.SimWorld.markers`) are drawn into
-hole scenes and reference scenes; a view with markers and no hole (a survey view) renders them
-with :func:`measure.synth.markers.render_markers_pair`. The part does not hide a marker.
+With the view axis on the calibration plate (at its true pose) in front of any hole, or with no
+hole in view and the plate anywhere in either image (a real camera sees it wherever it is), it
+renders the plate with :func:`measure.synth.targets.render_target_pair`.
+The reference markers in front of the head (at their true places,
+:attr:`cell.sim.world.SimWorld.markers`) are drawn into hole scenes and reference scenes; a view
+with markers and neither a hole nor the plate (a survey view) renders them with
+:func:`measure.synth.markers.render_markers_pair`. The part does not hide a marker, and a view
+of the plate shows no marker.
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ from cell.uncertainty.repeatability import sigma_per_axis_m
 from measure import StereoCalibration
 from measure.synth import RenderOptions, render_hole_pair, render_reference_pair
 from measure.synth.markers import MarkerPatch, render_markers_pair
-from measure.synth.targets import render_target_pair
+from measure.synth.targets import plate_box, render_target_pair
 from robots.transforms import invert
 
 
@@ -48,7 +51,8 @@ def true_head(stereo: StereoCalibration, scale: float, seed: int) -> StereoCalib
 
 #: a feature counts as "in front of the head" within this distance of the view axis (m)
 VIEW_AXIS_TOL_M = 0.02
-#: the calibration plate is rendered when the view axis meets it this far from the head (m)
+#: the calibration plate is rendered when the view axis meets it this far from the head, or
+#: when its centre is this far from the head and it shows in either image (m)
 TARGET_RANGE_M = (0.05, 1.0)
 
 
@@ -155,19 +159,37 @@ class SimCamera:
 
     def _target_distance(self, T_cell_tcp: np.ndarray) -> float | None:
         """How far along the head's view axis it meets the calibration plate's printed face
-        from in front (m; the plate's true pose), or None: not within ``TARGET_RANGE_M``."""
+        from in front (m; the plate's true pose), ``inf`` when the axis misses the plate but
+        the plate shows in either image (any hole on the axis then wins), or None: the face
+        turned away, out of view or not within ``TARGET_RANGE_M``."""
         T_cell_target = self.world.T_cell_target
         if T_cell_target is None:
             return None
         T = invert(T_cell_target) @ T_cell_tcp  # the head in the board frame
         o, d = T[:3, 3], T[:3, 2]
-        if not (o[2] < 0 < d[2]):  # the face is z = 0 and faces -z
+        if not o[2] < 0:  # the face is z = 0 and faces -z
             return None
-        s = float(-o[2] / d[2])
-        lo, hi = self.world.cell.calibration_target.target_spec().plate_bounds()
-        p = o + s * d
-        inside = lo[0] <= p[0] <= hi[0] and lo[1] <= p[1] <= hi[1]
-        return s if inside and TARGET_RANGE_M[0] <= s <= TARGET_RANGE_M[1] else None
+        spec = self.world.cell.calibration_target.target_spec()
+        lo, hi = spec.plate_bounds()
+        if d[2] > 0:
+            s = float(-o[2] / d[2])
+            p = o + s * d
+            inside = lo[0] <= p[0] <= hi[0] and lo[1] <= p[1] <= hi[1]
+            if inside and TARGET_RANGE_M[0] <= s <= TARGET_RANGE_M[1]:
+                return s
+        centre = np.array([0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.0])
+        if not TARGET_RANGE_M[0] <= float(np.linalg.norm(centre - o)) <= TARGET_RANGE_M[1]:
+            return None
+        T_left_target = invert(T_cell_tcp @ self._T_head_left) @ T_cell_target
+        T_right_left = np.eye(4)
+        T_right_left[:3, :3], T_right_left[:3, 3] = self.true_stereo.R, self.true_stereo.T
+        corners = np.array([[x, y, 0.0, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+        for side, Tc in (("left", T_left_target), ("right", T_right_left @ T_left_target)):
+            if np.all((corners @ Tc[2]) <= 0):  # wholly behind this camera
+                continue
+            if plate_box(self.true_stereo, side, Tc[:3, :3], Tc[:3, 3], spec) is not None:
+                return float("inf")
+        return None
 
     def _target_pair(self, T_cell_left: np.ndarray, seed: int) -> StereoPair:
         """Render the calibration plate at its true pose in the true head."""

@@ -174,7 +174,7 @@ def test_calibrate_stereo_and_the_older_form_reach_the_stereo_calibration(capsys
     assert "give a subcommand (stereo, hand-eye, cell, example)" in capsys.readouterr().err
 
 
-def test_a_blurred_image_is_refused_unless_a_wider_edge_is_allowed(
+def test_a_blurred_image_is_refused_with_strict_unless_a_wider_edge_is_allowed(
     rendered, tmp_path: Path, capsys
 ) -> None:
     def blur(rows, d):
@@ -185,8 +185,11 @@ def test_a_blurred_image_is_refused_unless_a_wider_edge_is_allowed(
     d, poses = _edited(rendered, tmp_path, "flange", blur)
     out = tmp_path / "cellcal.json"
     stereo = ["--stereo", str(folder / "stereo.json")]
-    assert _run(d, poses, out, *stereo) == 2
+    assert _run(d, poses, out, *stereo, "--strict") == 2
     assert "row 2: image L01.png: too blurred (edge width" in capsys.readouterr().err
     assert not out.exists()
+    assert _run(d, poses, out, *stereo) == 0  # by default: dropped with a warning
+    assert "row 2: image L01.png: too blurred" in capsys.readouterr().err
+    assert load_calibration(out).counts["views"] == 9
     assert _run(d, poses, out, *stereo, "--max-edge-width", "8") == 0
     assert load_calibration(out).counts["views"] == 10

@@ -3,6 +3,7 @@ quality flag: a suspect hole out of tolerance is a failed hole in the results an
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 from pathlib import Path
 from types import SimpleNamespace
@@ -61,4 +62,6 @@ def test_suspect_out_of_tolerance_fails_in_report(small_cell, monkeypatch, tmp_p
     files.store.close()
     assert summ["holes_failed"] == 1 and summ["holes_suspect"] == 1
     assert write_report(tmp_path)["holes_failed"] == 1
-    assert "False" in (tmp_path / "report.csv").read_text().splitlines()[1]
+    rows = csv.DictReader((tmp_path / "report.csv").open())
+    row = next(x for x in rows if x["characteristic"] == f"{r.hole_id}.position")
+    assert row["pass"] == "False" and row["decision"] == "nonconformance proven"

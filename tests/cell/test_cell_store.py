@@ -114,7 +114,10 @@ def test_report_files(tmp_path: Path) -> None:
     doc = json.loads((tmp_path / "report.json").read_text())
     assert [h["hole_id"] for h in doc["holes"]] == ["H1", "H2"]
     rows = list(csv.DictReader((tmp_path / "report.csv").open()))
-    assert rows[0]["pass"] == "True" and rows[1]["measured_x_m"] == ""
+    # no drawing: the run's position (⌀, 2 x 10 um) against the old tolerance's zone (⌀2t);
+    # no decision was stored, so no pass either
+    assert rows[0]["value_m"] == "0.00002000" and rows[0]["tolerance_m"] == "0.00010000"
+    assert rows[0]["pass"] == "" and rows[1]["measured_x_m"] == ""
     assert float(rows[0]["measured_z_m"]) == pytest.approx(0.30001)
     assert (tmp_path / "report.qif").is_file()
 

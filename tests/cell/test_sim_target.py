@@ -122,7 +122,7 @@ def test_the_head_sees_the_plate_where_the_truth_puts_it() -> None:
     np.testing.assert_allclose(g.T_cell_target, t.T_cell_target() @ truth.target_placement_error)
 
 
-def test_the_plate_is_seen_from_in_front_on_the_view_axis_only() -> None:
+def test_the_plate_is_seen_from_in_front_wherever_it_is_in_the_image() -> None:
     cell = load_builtin_cell()
     world = SimWorld(cell, WorldOptions(truth=CellTruth.zero(0)))
     cam = SimCamera(world, _Arm(cell.home_q()), cell_stereo(cell))
@@ -131,5 +131,8 @@ def test_the_plate_is_seen_from_in_front_on_the_view_axis_only() -> None:
     assert cam._target_distance(viewpoint(centre, normal, 0.25, 1.0)) == pytest.approx(0.25)
     assert cam._target_distance(viewpoint(centre, -normal, 0.25, 0.0)) is None  # from behind
     aside = centre + 0.1 * np.cross(normal, [0.0, 0.0, 1.0]) / np.linalg.norm(normal[:2])
-    assert cam._target_distance(viewpoint(aside, normal, 0.25, 0.0)) is None  # off the plate
+    # off the view axis but in the image (issue 26): seen, behind any hole on the axis
+    assert cam._target_distance(viewpoint(aside, normal, 0.25, 0.0)) == float("inf")
+    far_aside = centre + 0.6 * np.cross(normal, [0.0, 0.0, 1.0]) / np.linalg.norm(normal[:2])
+    assert cam._target_distance(viewpoint(far_aside, normal, 0.25, 0.0)) is None  # out of view
     assert cam._target_distance(viewpoint(centre, normal, 1.5, 0.0)) is None  # too far

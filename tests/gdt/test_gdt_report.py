@@ -75,8 +75,9 @@ def test_report_json_and_html_carry_the_characteristics(tmp_path: Path) -> None:
     assert counts["conformance"] >= 70 and counts["not_evaluated"] == 0
     by_hole = {h["hole_id"]: h for h in doc["holes"]}
     pos = next(c for c in chars if c["id"] == "SHL1.position")
-    assert by_hole["SHL1"]["position_deviation_m"] == pytest.approx(pos["value_m"] / 2)
-    assert by_hole["SHL1"]["U_position_m"] == pytest.approx(pos["U_m"] / 2)
+    assert by_hole["SHL1"]["position_m"] == pytest.approx(pos["value_m"])  # ISO 1101: the ⌀
+    assert by_hole["SHL1"]["U_position_m"] == pytest.approx(pos["U_m"])
+    assert by_hole["SHL1"]["position_frame"] == "DRF1"
     assert by_hole["SHL1"]["decision"] in ("conforming", "inconclusive")
     assert "<h2>Deviation vectors over the part</h2>" not in (tmp_path / "report.html").read_text()
 
@@ -93,6 +94,6 @@ def test_report_of_a_run_whose_datum_was_not_measured(tmp_path: Path) -> None:
                and c["kind"] == "position"]  # fmt: skip
     assert all(len(c["nominal_m"]) == 3 and c["value_m"] is None for c in not_pos)
     row = next(h for h in doc["holes"] if h["hole_id"] == "SHL1")
-    assert row["position_deviation_m"] is None and row["decision"] is None
+    assert row["position_m"] is None and row["decision"] is None
     assert "datum C" in row["reason"] and "HT1" in row["reason"]
     assert doc["summary"]["characteristics"]["not_evaluated"] == 40

@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import small_cell_text
+from referencing_cells import small_cell_text
 
 from cell.cli import main
 from cell.config import load_cell

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import small_cell_text, survey_observations
+from referencing_cells import small_cell_text, survey_observations
 
 from cell.config import builtin_cell_path, parse_cell
 from cell.referencing import MarkersFileError, SurveyRefusedError, load_markers, survey

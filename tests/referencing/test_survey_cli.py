@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import small_cell_text
+from referencing_cells import small_cell_text
 
 from cell.cli import main
 from cell.config import load_cell

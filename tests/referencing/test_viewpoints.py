@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import yaml
-from conftest import small_cell_text
+from referencing_cells import small_cell_text
 
 from cell.camera import cell_stereo
 from cell.config import builtin_cell_path, parse_cell

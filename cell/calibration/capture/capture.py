@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.calibration.capture.orient import orient_chessboard, refine_corners, repair_outliers
+from cell.calibration.estimate.soft_views import is_soft
 from cell.camera import CameraBackend
 from cell.link import messages as m
 from cell.link.client import ControllerClient
@@ -41,13 +42,16 @@ class CaptureSettings:
     """Motion and detection settings: wait after "in position" (s), longest move (s), how long
     a dead link is retried (s), widest accepted edge of a target image (px, 10-90 % rise);
     ``stop_on_unseen``: end the tour (home, then return the views so far) at the first view
-    whose left or right image lacks the target, which the calibration refuses anyway."""
+    whose left or right image lacks the target, which the calibration refuses anyway (a view
+    failing only a quality check is dropped instead, :mod:`cell.calibration.estimate.soft_views`,
+    unless ``strict``)."""
 
     settle_s: float = 0.2
     move_timeout_s: float = 120.0
     reconnect_budget_s: float = 15.0
     max_edge_width_px: float = 4.0
     stop_on_unseen: bool = True
+    strict: bool = False
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,6 +66,7 @@ class CapturedView:
     corners_right_px: Array | None
     reason_left: str = ""
     reason_right: str = ""
+    temperatures_c: Array | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,7 +168,7 @@ class TourCapture(Motion):
                 wall["capture_s"] += time.perf_counter() - t
                 if pending:  # the previous view's detection, done during this move
                     self._collect(views, pending.pop(), n, wall)
-                if stop_early and _unseen(views):
+                if stop_early and _unseen(views, self.options.strict):
                     break
                 pending.append((stop.hole_id, st, pool.submit(self._detect_pair, pair)))
                 del pair
@@ -183,11 +188,19 @@ class TourCapture(Motion):
         (left, why_left), (right, why_right), dt = future.result()
         wall["detect_s"] += dt
         q = np.asarray(st.q_rad, float).copy()
-        views.append(CapturedView(vid, q, float(st.time_s), left, right, why_left, why_right))
+        temps = np.asarray(st.temperatures_c, float).copy()  # the arm's warming (warming.py)
+        views.append(CapturedView(vid, q, float(st.time_s), left, right, why_left, why_right,
+                                  temps))  # fmt: skip
         self.progress("view", {"k": len(views) - 1, "n": n, "id": vid,
                                "left": left is not None, "right": right is not None})  # fmt: skip
 
 
-def _unseen(views: list[CapturedView]) -> bool:
-    """Whether the last view lacks the target in an image."""
-    return bool(views) and (views[-1].corners_left_px is None or views[-1].corners_right_px is None)
+def _unseen(views: list[CapturedView], strict: bool) -> bool:
+    """Whether the last view lacks the target in an image (for another reason than a quality
+    check, unless ``strict``)."""
+    if not views:
+        return False
+    v = views[-1]
+    return any(pts is None and (strict or not is_soft(why))
+               for pts, why in ((v.corners_left_px, v.reason_left),
+                                (v.corners_right_px, v.reason_right)))  # fmt: skip

@@ -14,7 +14,7 @@ refuses the file. :func:`calibrate_cell` returns just the calibration.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from cell.calibration.capture.capture import (
     CaptureSettings,
@@ -22,9 +22,11 @@ from cell.calibration.capture.capture import (
     TourCapture,
     TourCaptures,
 )
+from cell.calibration.capture.warming import MAX_K, TourWarming, check_warming, tour_warming
 from cell.calibration.errors import CalibrationDataError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
 from cell.calibration.estimate.result import CellCalibration
+from cell.calibration.estimate.soft_views import DroppedView, is_soft, solve_without
 from cell.calibration.estimate.solve import CalibrationResult, SolveOptions, solve_calibration
 from cell.calibration.file.provenance import cell_provenance
 from cell.camera import CameraBackend
@@ -47,6 +49,7 @@ class CalibrateCellOptions:
 
     capture: CaptureSettings = field(default_factory=CaptureSettings)
     solve: SolveOptions = field(default_factory=lambda: SolveOptions(estimate_intrinsics=True))
+    max_warming_K: float = MAX_K  # noqa: N815 (unit suffix): cell.calibration.capture.warming
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,6 +62,8 @@ class CellCalibrationRun:
     observations: CalibrationObservations
     result: CalibrationResult
     wall_s: float
+    dropped: tuple[DroppedView, ...] = ()
+    warming: TourWarming | None = None
 
     @property
     def calibration(self) -> CellCalibration:
@@ -96,18 +101,29 @@ def check_calibration_tour(cell: CellConfig, cal_tour: CalibrationTour, where: s
 
 
 def observations_of(
-    captures: TourCaptures, spec: TargetSpec, cameras: Cameras, source: str
-) -> CalibrationObservations:
+    captures: TourCaptures, spec: TargetSpec, cameras: Cameras, source: str,
+    strict: bool = False, dropped: list[DroppedView] | None = None,
+) -> CalibrationObservations:  # fmt: skip
     """The observations of a tour; a view whose left or right image lacks the target is
     refused naming the view and the reason (the tour plans every view with the whole board in
-    both images: a missing board means a wrong target pose, a camera fault or a blurred image,
-    which no calibration should silently absorb)."""
+    both images: a missing board means a wrong target pose or a camera fault, which no
+    calibration should silently absorb). A view failing only a quality check (a blurred image)
+    is appended to ``dropped`` and left out, unless ``strict``
+    (:mod:`cell.calibration.estimate.soft_views`)."""
     views = []
     for v in captures.views:
+        soft = None
         for side, pts, why in (("left", v.corners_left_px, v.reason_left),
                                ("right", v.corners_right_px, v.reason_right)):  # fmt: skip
             if pts is None and (side == "left" or cameras.stereo):
-                raise CalibrationDataError(source, f"{side} image: {why}; nothing written", v.id)
+                if strict or not is_soft(why):
+                    raise CalibrationDataError(source, f"{side} image: {why}; nothing written",
+                                               v.id)  # fmt: skip
+                soft = soft or DroppedView(v.id, f"{side} image: {why}")
+        if soft is not None:
+            if dropped is not None:
+                dropped.append(soft)
+            continue
         right = v.corners_right_px if cameras.stereo else None
         views.append(CalibrationView(v.id, v.corners_left_px, right, q_rad=v.q_rad))
     return CalibrationObservations(tuple(views), spec, cameras, source)
@@ -133,15 +149,32 @@ def run_calibration_tour(
     t0 = time.perf_counter()
     spec = check_calibration_tour(cell, tour, source)
     captures = TourCapture(tour.tour, client, camera, spec, o.capture, report).run()
+    warming = tour_warming([v.temperatures_c for v in captures.views],
+                           [v.time_s for v in captures.views])  # fmt: skip
+    warn = check_warming(warming, o.max_warming_K, source)  # refuses past the limit
+    if warming is not None:
+        report("warming", {"line": warning_or(warn, warming)})
     cameras = Cameras.from_stereo(camera.stereo)
-    obs = observations_of(captures, spec, cameras, source)
+    dropped: list[DroppedView] = []
+    obs = observations_of(captures, spec, cameras, source, o.capture.strict, dropped)
+    for d in dropped:
+        report("dropped", {"warning": d.warning(source, len(obs.views))})
     report("solve", {"views": len(obs.views)})
     dh = cell.build_robot().dh
     stereo_source = str(cell.calibration_path() or camera.stereo.source)
     prov = cell_provenance(cell, dh, stereo_source, camera.stereo.to_dict())
-    result = solve_calibration(obs, dh, o.solve, prov)
+    result = solve_without(dropped, source, solve_calibration, obs, dh, o.solve, prov)
+    if warming is not None:  # kept with the calibration
+        cal = replace(result.calibration, notes=(*result.calibration.notes, warming.line()))
+        result = replace(result, calibration=cal)
     report("done", {"total_s": result.timings["total_s"]})
-    return CellCalibrationRun(captures, obs, result, time.perf_counter() - t0)
+    return CellCalibrationRun(captures, obs, result, time.perf_counter() - t0, tuple(dropped),
+                              warming)  # fmt: skip
+
+
+def warning_or(warn: str, warming: TourWarming) -> str:
+    """The warning when there is one, else the plain report line."""
+    return warn or warming.line()
 
 
 def calibrate_cell(

@@ -113,7 +113,7 @@ def view_joints(
         tilt = max_tilt_rad * np.sqrt(rng.uniform(0.1, 1.0))
         R_tilt = Rotation.from_rotvec(tilt * np.array([np.cos(az), np.sin(az), 0.0]))
         roll = Rotation.from_rotvec([0, 0, rng.uniform(-max_roll_rad, max_roll_rad)])
-        R_target_cam = R_tilt * Rotation.from_rotvec([np.pi, 0, 0]) * roll
+        R_target_cam = R_tilt * roll  # the board frame's z into the plate: the camera's z
         T_target_cam = np.eye(4)
         T_target_cam[:3, :3] = R_target_cam.as_matrix()
         aim = centre + np.append(rng.uniform(-aim_spread_m, aim_spread_m, 2), 0.0)
@@ -210,8 +210,11 @@ def example_truth(
     cameras: Cameras | None = None,
 ) -> SyntheticTruth:
     """A ready cell: ``model`` on the origin, a plate 0.85 m in front of it at table height
-    (0.25 m), the standard toed-in head (:func:`measure.synth.heads.standard_stereo`) 0.1 m
-    below the flange, looking along ``tool0`` z."""
+    (0.25 m), face up, the standard toed-in head (:func:`measure.synth.heads.standard_stereo`)
+    0.1 m below the flange, looking along ``tool0`` z. The plate's frame is the board frame of
+    docs/conventions.md (z into the plate: down; the printed face, z = 0, faces -z: up), the
+    frame the detected corners are ordered in (:func:`cell.calibration.capture.orient_chessboard`),
+    so the truth and a calibration from images agree."""
     from measure.synth.heads import standard_stereo
     from robots.dh_models import dh_table
 
@@ -229,7 +232,8 @@ def example_truth(
         ).as_matrix()
         T_head_left[:3, 3] = -0.5 * b
     T_base_target = np.eye(4)
-    T_base_target[:3, 3] = (0.85, -0.04, 0.25)
+    T_base_target[:3, :3] = Rotation.from_rotvec([np.pi, 0, 0]).as_matrix()  # z down
+    T_base_target[:3, 3] = (0.85, 0.02, 0.25)
     return random_truth(
         dh_table(model),
         cams,
@@ -246,8 +250,7 @@ def reference_joints(truth: SyntheticTruth, standoff_m: float = 0.25) -> Array:
     p = truth.target.object_points()
     centre = 0.5 * (p.min(axis=0) + p.max(axis=0))
     T_target_cam = np.eye(4)
-    T_target_cam[:3, :3] = Rotation.from_rotvec([np.pi, 0, 0]).as_matrix()
-    T_target_cam[:3, 3] = centre + np.array([0, 0, standoff_m])
+    T_target_cam[:3, 3] = centre - np.array([0, 0, standoff_m])  # in front of the face (-z)
     T = truth.truth.T_base_target @ T_target_cam @ np.linalg.inv(truth.truth.T_tool0_camera)
     ik = solve_ik(truth.dh, T, np.full(6, -np.pi), np.full(6, np.pi))
     if not ik.ok:

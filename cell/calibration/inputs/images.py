@@ -1,12 +1,13 @@
 """The target's corners in the images of a poses CSV: the observations of an offline calibration.
 
 Every image named by a row is read (8 or 16 bit, colour turned to gray) and the target is
-searched with :func:`measure.target.find_target`. An image that cannot be read, has another
-size than the calibration's, or does not show the whole target is refused with its file and
-row named: a view without the target cannot be used, and guessing which image is wrong is
-left to the user. When the first image lacks only the target, up to :data:`HINT_ROWS` other
-rows' images are searched too: if none shows it, the board size given (``--cols``/``--rows``)
-is the likely mistake and the refusal says so.
+searched with :func:`measure.target.find_target`, its corners put in the board frame's
+order (:func:`cell.calibration.capture.orient_chessboard`: docs/conventions.md). An image that
+cannot be read, has another size than the calibration's, or does not show the whole target is
+refused with its file and row named: a view without the target cannot be used, and guessing
+which image is wrong is left to the user. When the first image lacks only the target, up to
+:data:`HINT_ROWS` other rows' images are searched too: if none shows it, the board size given
+(``--cols``/``--rows``) is the likely mistake and the refusal says so.
 """
 
 from __future__ import annotations
@@ -17,8 +18,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from cell.calibration.capture.orient import orient_chessboard
 from cell.calibration.errors import CalibrationDataError, TargetNotFoundError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
+from cell.calibration.estimate.soft_views import DroppedView, is_soft
 from cell.calibration.inputs.posecsv import PoseRow
 from measure.target import MAX_EDGE_WIDTH_PX, TargetSpec, find_target
 
@@ -52,7 +55,7 @@ def _corners(
     det = find_target(img, spec, blur_px)
     if det.points is None:
         raise TargetNotFoundError(src, f"image {path.name}: {det.reason}", row)
-    return det.points
+    return orient_chessboard(img, det.points, spec)  # the board frame's order
 
 
 def board_size_hint(spec: TargetSpec) -> str:
@@ -71,9 +74,13 @@ def observations_from_images(
     cameras: Cameras,
     source: str,
     max_edge_width_px: float = MAX_EDGE_WIDTH_PX,
+    strict: bool = False,
+    dropped: list[DroppedView] | None = None,
 ) -> CalibrationObservations:
     """Detect the target in every row's image(s) and build the observations; an image whose
-    edges are wider than ``max_edge_width_px`` (10-90 % rise) counts as too blurred."""
+    edges are wider than ``max_edge_width_px`` (10-90 % rise) counts as too blurred: its view
+    is appended to ``dropped`` and left out (:mod:`cell.calibration.estimate.soft_views`), or,
+    with ``strict``, refused."""
     folder = Path(images_dir)
     if not folder.is_dir():
         raise CalibrationDataError(str(images_dir), "not a folder of images")
@@ -107,6 +114,10 @@ def observations_from_images(
         try:
             views.append(view(r))
         except TargetNotFoundError as exc:
+            if not strict and is_soft(exc.reason.split(": ", 1)[-1]):
+                if dropped is not None:
+                    dropped.append(DroppedView(r.row, exc.reason))
+                continue
             if views:
                 raise
             others = _spread(rows[k + 1 :], HINT_ROWS)

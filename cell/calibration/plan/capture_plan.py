@@ -22,8 +22,8 @@ from planner.planner import ProgressCallback
 
 #: sideways offsets of the candidate views (x standoff): half of plan-calibration's default.
 #: With the full 0.1 x standoff diagonal offsets a 50 deg tilted view meets the board 55 mm
-#: from its centre, past the plate's edge for the 9 x 6 board of the built-in cell; the
-#: simulated head (cell.sim.camera) renders the plate only where its view axis meets it.
+#: from its centre, past the plate's edge for the 9 x 6 board of the built-in cell (the
+#: board then sits near the image border, where a few millimetres of error can cut it off).
 CALIBRATE_OFFSETS = ((0.0, 0.0), (0.05, 0.05), (-0.05, 0.05), (0.05, -0.05), (-0.05, -0.05))
 #: the features stay this share of the image width inside its border in both cameras
 CALIBRATE_MARGIN_FRAC = 0.04

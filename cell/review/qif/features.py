@@ -141,7 +141,8 @@ def measured_features(
     ids: Ids,
 ) -> None:
     """Fill ``<MeasuredFeatures>`` ``mf``: a circle measurement per measured hole (centre with
-    ``combinedUncertainty`` = U_position/2, the measured axis when known, diameter with
+    ``combinedUncertainty`` = U_position/4 (U_position is the U of the position's ⌀: the
+    centre's expanded uncertainty is half of it, k = 2), the measured axis when known, diameter with
     ``combinedUncertainty`` = U_diameter/2; k = 2 is the report's coverage factor); in a
     referenced run an attribute ``located_by`` says by which markers the stop was located, or
     that it fell back to the arm."""
@@ -159,7 +160,7 @@ def measured_features(
         sub(m, "FeatureItemId", str(f.item))
         loc = sub(m, "Location", vec(centre))
         if h.get("U_position_m") is not None:
-            loc.set("combinedUncertainty", dec(h["U_position_m"] / 2.0))
+            loc.set("combinedUncertainty", dec(h["U_position_m"] / 4.0))
         if h["hole_id"] in measured_normals:
             sub(m, "Normal", vec(_unit(measured_normals[h["hole_id"]], f"{h['hole_id']} axis")))
         dia = sub(m, "Diameter", dec(h["diameter_m"]))

@@ -1,5 +1,6 @@
 """The individuals and moving-range charts of one characteristic as inline SVG
-(:mod:`cell.review.svg` helpers). Position values in um, diameters in mm."""
+(:mod:`cell.review.svg` helpers). Position values (ISO 1101: the zone's diameter ⌀) in µm,
+diameters in mm."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ WIDTH, HEIGHT = 640, 220
 
 def unit(kind: str) -> tuple[float, str]:
     """(scale from m, label) of a characteristic kind's charts and table."""
-    return (1e6, "um") if kind == "position" else (1e3, "mm")
+    return (1e6, "µm") if kind == "position" else (1e3, "mm")
 
 
 def _chart(
@@ -82,7 +83,7 @@ def charts(s: Series, cap: Capability) -> str:
         limits,
         flagged,
         f"{s.name}: individuals",
-        f"{s.kind} ({u})",
+        f"position ⌀ ({u}, ISO 1101)" if s.kind == "position" else f"{s.kind} ({u})",
     )
     mr = np.abs(np.diff(x))
     mr_flag = {i - 1 for i, rules in cap.out_of_control.items() if "mr_beyond_ucl" in rules}
