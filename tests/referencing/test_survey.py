@@ -135,3 +135,14 @@ def test_markers_file_round_trip_and_refusals(surveyed, small_cell, stereo, tmp_
     path.write_text(json.dumps(doc | {"version": 9}))
     with pytest.raises(MarkersFileError, match="version"):
         load_markers(path)
+
+
+def test_the_self_calibrated_head_carries_the_adjustments_uncertainty(surveyed, stereo):
+    """The survey's head states the marginal σ of its camera matrices and rig, tighter than the
+    default figures of a careful calibration it started from; k3, not estimated, keeps those."""
+    from cell.uncertainty.calibration import default_uncertainty
+
+    u, d = surveyed[1].stereo.uncertainty, default_uncertainty(stereo)
+    assert u is not None and "survey" in u.method
+    assert np.all(u.K_std_left_px < d.K_std_left_px) and np.all(u.T_std_m < d.T_std_m)
+    assert u.dist_std_left[4] == d.dist_std_left[4]

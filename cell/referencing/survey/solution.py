@@ -25,6 +25,10 @@ class RawSolution:
     dof: int
     iterations: int
     head: tuple[Array, Array, Array, Array, Array] | None = None
+    #: the self-calibrated head's marginal covariances: each camera's Cal3DS2 (9, 9: fx, fy,
+    #: skew, cx, cy, k1, k2, p1, p2) and the rig's Pose3 (6, 6: rotation, translation in its own
+    #: frame); None: not computed
+    head_covariance: tuple[Array, Array, Array] | None = None
 
     @property
     def variance_factor(self) -> float:

@@ -138,11 +138,13 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     cams = [result.atCal3DS2(C(c)) for c in range(2)]
     head = (_K(cams[0]), _K(cams[1]), result.atPose3(R(0)).matrix(), _lens(cams[0]), _lens(cams[1]))
     chi2 = 2.0 * graph.error(result)
-    cov = None
+    cov, head_cov = None, None
     if covariance:
         marginals = gtsam.Marginals(graph, result)
         keys = gtsam.KeyVector()
         for j in range(problem.n_markers):
             keys.append(L(j))
-        cov = marginals.jointMarginalCovariance(keys).fullMatrix() * max(1.0, chi2 / dof)
-    return RawSolution(points, poses, cov, chi2, dof, int(opt.iterations()), head)
+        scale = max(1.0, chi2 / dof)
+        cov = marginals.jointMarginalCovariance(keys).fullMatrix() * scale
+        head_cov = tuple(marginals.marginalCovariance(k) * scale for k in (C(0), C(1), R(0)))
+    return RawSolution(points, poses, cov, chi2, dof, int(opt.iterations()), head, head_cov)

@@ -24,7 +24,10 @@ from cell.referencing.survey.refusals import check_network, usable_views
 from cell.referencing.survey.result import SurveyResult
 from cell.referencing.survey.solution import RawSolution
 from cell.referencing.survey.solve_gtsam import solve_gtsam
+from cell.uncertainty.calibration import default_uncertainty
 from measure import StereoCalibration
+from measure.calibration_uncertainty import CalibrationUncertainty
+from robots.transforms import skew
 
 #: an observation this many σ off is an outlier
 OUTLIER_SIGMA = 5.0
@@ -112,7 +115,7 @@ def survey(
         outliers=tuple(outliers),
         warnings=tuple(warnings),
         timings={"adjust_s": t1 - t0, "covariance_s": t2 - t1},
-        stereo=refined_head(stereo, raw.head),
+        stereo=refined_head(stereo, raw.head, raw.head_covariance, float(np.sqrt(np.mean(res**2)))),
     )
 
 
@@ -151,10 +154,52 @@ def _scale(problem: SurveyProblem, points: Array, cov: Array) -> tuple[float, st
     return max(ppm, BASELINE_SCALE_PPM), "the head's baseline alone"
 
 
-def refined_head(stereo: StereoCalibration, head: Head | None) -> StereoCalibration:
+def head_uncertainty(
+    stereo: StereoCalibration, head: Head, covariance: tuple[Array, Array, Array], rms_px: float
+) -> CalibrationUncertainty:
+    """The self-calibrated head's one-sigma uncertainties from the adjustment's marginals: the
+    camera matrices' and lens terms' (k3, not estimated, keeps ``stereo.json``'s stated σ, or
+    the default figure's), and the rig's: ``stereo.R = R_lr^T``, ``stereo.T = -R_lr^T t_lr``
+    with the Pose3 perturbation ``(ω, v)`` in the rig's own frame give ``δrvec = -ω`` and
+    ``δT = -v - [T']ω`` (``T' = R_lr^T t_lr``)."""
+    C_l, C_r, C_rig = (np.asarray(c, float) for c in covariance)
+    base = stereo.uncertainty or default_uncertainty(stereo)
+    K_std, dist_std = [], []
+    for c, side in ((C_l, "left"), (C_r, "right")):
+        sd = np.sqrt(np.clip(np.diag(c), 0.0, None))
+        K_std.append(sd[[0, 1, 3, 4]])
+        k3 = float(getattr(base, f"dist_std_{side}")[4])
+        dist_std.append(np.array([*sd[5:9], k3]))
+    T_lr = head[2]
+    Tp = T_lr[:3, :3].T @ T_lr[:3, 3]
+    J = np.zeros((6, 6))  # (rvec, T) from (ω, v)
+    J[:3, :3] = -np.eye(3)
+    J[3:, :3] = -skew(Tp)
+    J[3:, 3:] = -np.eye(3)
+    C = J @ C_rig @ J.T
+    sd = np.sqrt(np.clip(np.diag(C), 0.0, None))
+    return CalibrationUncertainty(
+        K_std[0],
+        dist_std[0],
+        K_std[1],
+        dist_std[1],
+        sd[:3],
+        sd[3:],
+        float(rms_px),
+        method="the survey adjustment's marginals",
+    )
+
+
+def refined_head(
+    stereo: StereoCalibration,
+    head: Head | None,
+    covariance: tuple[Array, Array, Array] | None = None,
+    rms_px: float = 0.0,
+) -> StereoCalibration:
     """``stereo`` with the survey's self-calibrated camera matrices, rig and lens terms (its
     k3 and image size kept; the residual lens terms are added to ``stereo.json``'s, a first-order
-    approximation as they are small)."""
+    approximation as they are small), and with ``covariance`` (the adjustment's marginals) its
+    uncertainty block."""
     if head is None:
         return stereo
     K_l, K_r, T_lr, d_l, d_r = head
@@ -173,4 +218,7 @@ def refined_head(stereo: StereoCalibration, head: Head | None) -> StereoCalibrat
         T_rl[:3, :3],
         T_rl[:3, 3],
         source=f"{stereo.source} (refined by the survey)",
+        uncertainty=(
+            None if covariance is None else head_uncertainty(stereo, head, covariance, rms_px)
+        ),
     )
