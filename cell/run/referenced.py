@@ -166,3 +166,20 @@ def referenced_contributions(
     survey = Contribution("survey_markers", J @ cov_m @ J.T, 0.0,
                           f"the surveyed markers' covariance ({network_source})")  # fmt: skip
     return [fit, calibration, image, survey, temperature]
+
+
+def located_note(hole_id: str, located: LocatedStop) -> tuple[str, str] | None:
+    """The run-log event of a stop's referencing when there is something to say."""
+    r = located.resection
+    if not located.referenced:
+        return "referencing", (f"{hole_id}: not referenced ({r.reason}): carried into the part by "
+                               "the arm, with the arm's budget")  # fmt: skip
+    if r.refused:
+        refused = "; ".join(f"{m}: {why}" for m, why in r.refused.items())
+        return "referencing", f"{hole_id}: marker(s) refused: {refused}"
+    if located.flagged:
+        return "fault", (f"{hole_id}: the markers place the head {located.registered_m * 1e3:.2f}"
+                         " mm from where the arm, registered to them on the stops before, says "
+                         f"it is (over {ARM_DISAGREEMENT_M * 1e3:g} mm): a bumped fixture, moved "
+                         "markers or a wrong calibration?")  # fmt: skip
+    return None

@@ -27,35 +27,25 @@ from cell.config.markers import marker_codes
 from cell.errors import CellError
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError, RunFaultError
-from cell.link.motion import Motion
 from cell.records.hole_result import HoleResult
 from cell.referencing.detection import detect_pair, label_circles
 from cell.referencing.network import MarkerNetwork
 from cell.review.audit_images import save_pair
 from cell.review.store import Store
 from cell.run.inspect import T_cell_tcp, inspect_hole, uncaptured_hole
-from cell.run.reference import target_of
-from cell.run.referenced import (
-    ARM_DISAGREEMENT_M,
-    ArmRegistration,
-    LocatedStop,
-    locate_stop,
-)
+from cell.run.reference_phase import ReferencePhase
+from cell.run.referenced import ArmRegistration, LocatedStop, locate_stop, located_note
 from cell.run.thermal_record import remember_model, stored_model, stored_rows
 from cell.run.thermal_update import ThermalUpdate
 from cell.uncertainty.context import BudgetContext, budget_context
 from cell.uncertainty.decision import DEFAULT_RULE
 from cell.uncertainty.part_temperature import PartThermalState, part_state
-from measure import MeasurementError, head_frame, measure_hole
+from measure import head_frame
 from planner import Tour
 from robots.thermal.model import ThermalModel
 from robots.transforms import invert
 
 log = logging.getLogger(__name__)
-
-#: the arm is at a joint vector if every joint is within this (rad; half the controller's
-#: on-path tolerance of 1e-3 degrees)
-HOME_TOL_RAD = float(np.deg2rad(0.5e-3))
 
 
 @dataclass(frozen=True)
@@ -111,7 +101,7 @@ class RunResult:
 Progress = Callable[[str, dict], None]
 
 
-class Runner(Motion):
+class Runner(ReferencePhase):
     """Runs one tour of one cell on one controller, storing into one run store."""
 
     def __init__(
@@ -298,81 +288,8 @@ class Runner(Motion):
             part = PartThermalState.from_dict(stored)
         return budget_context(self.cell, self.stereo, part, o.decision_rule)
 
-    # --- reference targets -----------------------------------------------------------------
-    def _home_for_reference(self) -> None:
-        """Bring the arm home if it is elsewhere (a resumed run stopped at a hole, between holes
-        or on the way to a reference target): the reference trajectory starts at home, and a
-        controller refuses to load a trajectory the arm is not on, so the arm goes home along
-        whichever of the two tours it stands on."""
-        home = np.asarray(self.reference_tour.trajectory[0], float)
-        st = self._call("status", self.client.status)
-        if np.max(np.abs(st.q_rad - home)) <= HOME_TOL_RAD:
-            return
-        tours = {"inspection": self.tour, "reference": self.reference_tour}
-        name = min(tours, key=lambda n: _distance_to_path_rad(tours[n], st.q_rad))
-        self.store.event("motion", f"the arm is off home: homing along the {name} tour before "
-                                   "the reference targets")  # fmt: skip
-        self._load(tours[name])
-        self._move(len(tours[name].stops), "home before the reference targets")
-
-    def _reference_phase(self) -> None:
-        tour = self.reference_tour
-        self._load(tour)
-        for rnd in range(self.options.reference_rounds):
-            st_start = self._call("status", self.client.status)
-            t_start = st_start.time_s
-            if self.thermal.cold_degC is None:  # the cold state: before the arm first moves
-                self.thermal.cold_degC = tuple(float(v) for v in st_start.temperatures_c)
-                self.store.set_thermal_reference(self.thermal.cold_degC)
-            self.progress("round", {"round": rnd, "time_s": t_start})
-            for k, s in enumerate(tour.stops):
-                self._move(k, f"reference {s.hole_id}")
-                st = self._settled_status()
-                try:
-                    pair = self.camera.capture()
-                    exclude = None
-                    if self.codes:  # the markers' labels are not the reference target
-                        dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
-                        exclude = label_circles(dets)
-                    meas = measure_hole(pair.left, pair.right, self.stereo, exclude=exclude)
-                except (MeasurementError, PairError) as exc:
-                    self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
-                    continue
-                p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
-                target = target_of(s.hole_id)
-                row = (st.time_s, target, st.q_rad, st.temperatures_c, p_tcp, self._round0 + rnd)
-                self.store.record_reference(row[5], *row[:5])
-                self.thermal.add(*row)
-                self.progress("reference", {"round": rnd, "target": s.hole_id})
-            self._move(len(tour.stops), "reference home")
-            if rnd + 1 < self.options.reference_rounds:
-                self._wait_controller_time(t_start + self.options.reference_interval_s)
-
-    def _wait_controller_time(self, t_s: float) -> None:
-        while self._call("status", self.client.status).time_s < t_s:
-            time.sleep(0.01)
-
-    def _identify(self) -> str:
-        model = self.thermal.identify()
-        if model is None:
-            msg = f"thermal model not updated: {self.thermal.refusal}"
-            if self.model is not None and self.thermal.rows:
-                rms = self.thermal.check(self.model)
-                msg += f"; the given model predicts the reference targets to {rms * 1e6:.1f} um RMS"
-        else:
-            self.model = model
-            r = self.thermal.result
-            self.model_id = remember_model(self.store, model, f"identified from {r.n_rows} rows")
-            msg = (
-                f"thermal model identified from {r.n_rows} rows: terms {', '.join(r.report.kept)};"
-                f" residual {r.residual_rms_m * 1e6:.1f} um"
-                f" (before {r.residual_rms_before_m * 1e6:.1f} um)"
-            )
-        self.store.event("thermal", msg)
-        return msg
-
     def _note_located(self, hole_id: str, located: LocatedStop) -> None:
-        note = _located_note(hole_id, located)
+        note = located_note(hole_id, located)
         if note is not None:
             self.store.event(*note)
             log.warning("%s", note[1])
@@ -440,23 +357,6 @@ class Runner(Motion):
         return result, clock.laps
 
 
-def _located_note(hole_id: str, located: LocatedStop) -> tuple[str, str] | None:
-    """The run-log event of a stop's referencing when there is something to say."""
-    r = located.resection
-    if not located.referenced:
-        return "referencing", (f"{hole_id}: not referenced ({r.reason}): carried into the part by "
-                               "the arm, with the arm's budget")  # fmt: skip
-    if r.refused:
-        refused = "; ".join(f"{m}: {why}" for m, why in r.refused.items())
-        return "referencing", f"{hole_id}: marker(s) refused: {refused}"
-    if located.flagged:
-        return "fault", (f"{hole_id}: the markers place the head {located.registered_m * 1e3:.2f}"
-                         " mm from where the arm, registered to them on the stops before, says "
-                         f"it is (over {ARM_DISAGREEMENT_M * 1e3:g} mm): a bumped fixture, moved "
-                         "markers or a wrong calibration?")  # fmt: skip
-    return None
-
-
 class _Laps:
     def __init__(self) -> None:
         self.laps: dict[str, float] = {}
@@ -465,9 +365,3 @@ class _Laps:
     def lap(self, name: str) -> None:
         t = time.perf_counter()
         self.laps[name], self._t = t - self._t, t
-
-
-def _distance_to_path_rad(tour: Tour, q_rad: np.ndarray) -> float:
-    """Largest joint difference (rad) between ``q_rad`` and the nearest sample of the tour."""
-    rows = np.asarray(tour.trajectory, float)
-    return float(np.min(np.max(np.abs(rows - q_rad), axis=1)))
