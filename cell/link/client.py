@@ -4,7 +4,9 @@ Stop-and-wait: one request is outstanding at a time; the controller answers ever
 an ACK (carrying the answer) or a NAK, both echoing the request's sequence number. A request
 without a valid answer within ``response_timeout_s``, or answered by a CRC NAK, is sent again
 with the same sequence number; the controller answers a repeat from its cache without acting
-twice. After ``retries`` repeats the link is declared dead (:class:`LinkError`).
+twice. After ``retries`` repeats the link is declared dead (:class:`LinkError`). A heartbeat
+that gets no answer declares it dead too: the next request raises :class:`LinkError` at once, so
+its caller reconnects (the line may answer again by then, but whatever was in flight is lost).
 """
 
 from __future__ import annotations
@@ -61,6 +63,8 @@ class ControllerClient:
         self._last_tx = 0.0
         self._stop_hb = threading.Event()
         self._hb_thread: threading.Thread | None = None
+        #: why the heartbeat found the link dead (None: it did not); the next request raises it
+        self._lost: str | None = None
 
     # --- connection -------------------------------------------------------------------------
     def connect(self) -> m.Identity:
@@ -68,6 +72,7 @@ class ControllerClient:
         with self._lock:
             self._port = open_port(self.url, self.options.baudrate, self.options.open_timeout_s)
             self._decoder = fr.FrameDecoder()
+            self._lost = None
             self.identity = m.Identity.unpack(self.request(m.Msg.IDENTIFY))
         if self.identity.version != m.PROTOCOL_VERSION:
             raise LinkError(
@@ -125,6 +130,9 @@ class ControllerClient:
         with self._lock:
             if self._port is None:
                 raise LinkError(self.url, "not connected")
+            if self._lost is not None:  # the heartbeat found the line dead: reconnect first
+                why, self._lost = self._lost, None
+                raise LinkError(self.url, f"the heartbeat got no answer ({why})")
             self._seq = (self._seq + 1) & 0xFF
             seq = self._seq
             wire = fr.encode(msg, seq, payload)
@@ -171,8 +179,12 @@ class ControllerClient:
                 continue
             try:
                 self.request(m.Msg.HEARTBEAT)
-            except (LinkError, RequestRefusedError) as exc:
+            except LinkError as exc:  # the line is dead: the next request says so
                 log.info("heartbeat failed: %s", exc)
+                with self._lock:
+                    self._lost = str(exc)
+            except RequestRefusedError as exc:
+                log.info("heartbeat refused: %s", exc)
 
     # --- commands ---------------------------------------------------------------------------
     def status(self) -> m.Status:
