@@ -20,7 +20,7 @@ DESCRIPTION = (
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``survey`` to the top-level commands."""
-    from cell.commands.argtypes import non_negative_float, positive_float
+    from cell.commands.argtypes import non_negative_float, output_file, positive_float
 
     p = sub.add_parser("survey", help="survey the reference markers: markers.json",
                        description=DESCRIPTION)  # fmt: skip
@@ -29,7 +29,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--camera", required=True, help="stereo head: tcp://HOST:PORT or gige://IP_LEFT,IP_RIGHT"
     )
-    p.add_argument("-o", "--output", default="markers.json", help="file to write (markers.json)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=output_file,
+        default="markers.json",
+        help="file to write (markers.json)",
+    )
     p.add_argument(
         "--settle-s",
         type=non_negative_float,
@@ -45,15 +51,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the tour's planning")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)
-
-
-def _check_output(out: Path) -> None:
-    from cell.errors import CellError
-
-    if out.is_dir():
-        raise CellError(f"-o {out}: is a directory; give a file name such as markers.json")
-    if not out.parent.exists():
-        raise CellError(f"-o {out}: folder {out.parent} does not exist")
 
 
 def _progress(quiet: bool):
@@ -78,7 +75,6 @@ def run(args: argparse.Namespace) -> int:
     from planner import Options
 
     out = Path(args.output)
-    _check_output(out)
     check_camera_url(args.camera)
     cell = load_cell(args.cell)
     if not cell.reference_markers:
