@@ -165,6 +165,7 @@ def format_survey(res: DemoResult) -> str:
                                + (f"; {flagged} off the registered arm by > 1 mm"
                                   if flagged else "")),
         ("  file", str(v.path)),
+        *((("  survey tour", v.plan_cache),) if v.plan_cache else ()),
     ]  # fmt: skip
     width = max(len(k) for k, _ in rows)
     return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)

@@ -40,10 +40,10 @@ def cache_dir() -> Path:
     return Path(env) if env else Path(platformdirs.user_cache_dir("holecell"))
 
 
-def _code_digest() -> str:
+def _code_digest(packages: tuple[str, ...] = _CODE) -> str:
     root = Path(__file__).resolve().parents[2]
     h = hashlib.sha256()
-    for pkg in _CODE:
+    for pkg in packages:
         for f in sorted((root / pkg).rglob("*.py")):
             h.update(str(f.relative_to(root)).encode())
             h.update(f.read_bytes())
@@ -62,16 +62,36 @@ def caltour_key(cell: Any, options: Any, views: int, seed: int) -> str:
     return hashlib.sha256(json.dumps(what, sort_keys=True).encode()).hexdigest()
 
 
+def plan_key(what: dict[str, Any], packages: tuple[str, ...] = _CODE) -> str:
+    """SHA-256 (hex) of ``what`` (JSON-ready) and of the source of ``packages``."""
+    return hashlib.sha256(
+        json.dumps({**what, "code": _code_digest(packages)}, sort_keys=True).encode()
+    ).hexdigest()
+
+
 def cached_caltour(
     key: str, plan: Callable[[], dict[str, Any]], folder: Path | None = None
 ) -> tuple[dict[str, Any], str]:
     """The calibration tour (``caltour.json`` mapping) for ``key``: read from the cache, else
     ``plan()`` and stored. Returns it and a sentence saying which."""
-    path = (folder or cache_dir()) / f"caltour-{key[:24]}.json"
+    return cached_plan("caltour", key, plan, caltour_from_dict, folder)
+
+
+def cached_plan(
+    name: str,
+    key: str,
+    plan: Callable[[], dict[str, Any]],
+    check: Callable[[dict[str, Any], str], Any],
+    folder: Path | None = None,
+) -> tuple[dict[str, Any], str]:
+    """A planned mapping for ``key``, kept as ``<name>-<key>.json``: read from the cache (and
+    ``check(data, path)``: raises :class:`PlanningError` or ValueError when it is not one),
+    else ``plan()`` and stored. Returns it and a sentence saying which."""
+    path = (folder or cache_dir()) / f"{name}-{key[:24]}.json"
     if path.is_file():
         try:
             data = json.loads(path.read_text())
-            caltour_from_dict(data, str(path))
+            check(data, str(path))
             return data, f"from the cache {path} (planned once per cell; delete it to plan again)"
         except (
             OSError,

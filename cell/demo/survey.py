@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from cell.config import CellConfig
+from cell.demo.caltour_cache import cached_plan, plan_key
 from cell.referencing import save_markers
 from cell.referencing.markersfile import MARKERS_FILENAME
 from cell.referencing.survey.gauge import rigid_fit
@@ -37,21 +38,36 @@ class DemoSurvey:
     solve_s: float = float("nan")
     scale_error_ppm: float = float("nan")
     within_2sigma: float = float("nan")
+    plan_cache: str = ""
+
+
+#: the source that decides the survey tour (its cache key)
+SURVEY_PLAN_CODE = ("planner", "robots", "cell/referencing", "cell/demo", "cell/config")
 
 
 def plan_demo_survey(seed: int) -> dict:
     """The built-in cell's survey tour as ``holecell survey`` plans it (JSON-ready: planned in a
-    worker process)."""
+    worker process), planned once per cell, seed and code and then read from the user's cache
+    folder (:mod:`cell.demo.caltour_cache`; ``plan_cache`` says which)."""
     from cell.camera import cell_stereo
     from cell.config import load_builtin_cell
     from cell.referencing.survey.tour import plan_survey_tour
     from planner import Options
+    from planner.cell_identity import cell_sha256
 
     cell = load_builtin_cell()
-    planned = plan_survey_tour(cell, cell_stereo(cell), options=Options(seed=seed))
-    return {"tour": planned.tour.to_dict(),
-            "T_cell_left": {k: v.tolist() for k, v in planned.T_cell_left.items()},
-            "left_out": planned.left_out}  # fmt: skip
+
+    def plan() -> dict:
+        planned = plan_survey_tour(cell, cell_stereo(cell), options=Options(seed=seed))
+        return {"tour": planned.tour.to_dict(),
+                "T_cell_left": {k: v.tolist() for k, v in planned.T_cell_left.items()},
+                "left_out": planned.left_out}  # fmt: skip
+
+    key = plan_key({"plan": "survey", "cell": cell_sha256(cell), "seed": seed},
+                   SURVEY_PLAN_CODE)  # fmt: skip
+    data, note = cached_plan("survey", key, plan, lambda d, src: survey_tour_from_dict(d))
+    data["plan_cache"] = note
+    return data
 
 
 def survey_tour_from_dict(data: dict) -> SurveyTour:
@@ -60,7 +76,7 @@ def survey_tour_from_dict(data: dict) -> SurveyTour:
 
     return SurveyTour(tour_from_dict(data["tour"], "survey tour"),
                       {k: np.asarray(v, float) for k, v in data["T_cell_left"].items()},
-                      dict(data["left_out"]))  # fmt: skip
+                      dict(data["left_out"]), str(data.get("plan_cache", "")))  # fmt: skip
 
 
 def survey_demo_cell(
@@ -95,4 +111,4 @@ def survey_demo_cell(
     z = np.abs(P - (true @ G[:3, :3].T + G[:3, 3])) / r.sigma_m()
     return DemoSurvey(path, r, time.perf_counter() - t0, done.captures.robot_time_s,
                       float(np.sqrt(np.mean(e**2))), float(e.max()), done.solve_s, float(scale),
-                      float(np.mean(z < 2.0)))  # fmt: skip
+                      float(np.mean(z < 2.0)), planned.plan_cache)  # fmt: skip

@@ -50,6 +50,8 @@ class SurveyTour:
     tour: Tour
     T_cell_left: dict[str, Array]
     left_out: dict[str, str] = field(default_factory=dict)
+    #: where the plan came from when it was kept in a cache (the demo's), else empty
+    plan_cache: str = ""
 
 
 def _group(arm, vid: str, T_cell_tcp: Array) -> tuple[HoleCandidates | None, str]:
