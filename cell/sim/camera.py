@@ -11,7 +11,8 @@ renders the plate with :func:`measure.synth.targets.render_target_pair`.
 The reference markers in front of the head (at their true places,
 :attr:`cell.sim.world.SimWorld.markers`) are drawn into hole scenes and reference scenes; a view
 with markers and neither a hole nor the plate (a survey view) renders them with
-:func:`measure.synth.markers.render_markers_pair`. The part does not hide a marker, and a view
+:func:`measure.synth.markers.render_markers_pair`. A hole scene's surface (a plane across the
+whole image) hides the markers behind it; otherwise the part does not hide a marker, and a view
 of the plate shows no marker.
 """
 
@@ -119,7 +120,11 @@ class SimCamera:
         self.captures += 1
         if kind == "target":
             return self._target_pair(T_cell_left, seed)
-        markers = self._marker_patches(T_left_cell)
+        surface = None
+        if feature is not None:
+            surface = (T_left_cell[:3, :3] @ feature.position_m + T_left_cell[:3, 3],
+                       T_left_cell[:3, :3] @ feature.normal)  # fmt: skip
+        markers = self._marker_patches(T_left_cell, surface)
         if feature is not None and float(T_left_cell[:3, :3] @ feature.normal
                                          @ (T_left_cell[:3, :3] @ feature.position_m
                                             + T_left_cell[:3, 3])) >= 0.0:  # fmt: skip
@@ -143,17 +148,24 @@ class SimCamera:
         )
         return StereoPair(pair.left, pair.right)
 
-    def _marker_patches(self, T_left_cell: np.ndarray) -> list[MarkerPatch]:
+    def _marker_patches(
+        self, T_left_cell: np.ndarray, surface: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> list[MarkerPatch]:
         """The true markers facing the head and projecting into (or near) either image, in the
-        left camera frame."""
+        left camera frame; ``surface`` (a point and its normal, left frame): a hole scene's
+        plane, which hides every marker more than :data:`BEHIND_SURFACE_M` behind it."""
         mt = self.world.markers
         if mt is None:
             return []
         R, t = T_left_cell[:3, :3], T_left_cell[:3, 3]
         p_left = mt.true @ R.T + t
         n_left = mt.normals @ R.T
+        seen = _in_either_image(self.true_stereo, p_left, n_left)
+        if surface is not None:  # the scene's plate spans the whole image
+            c, n = surface
+            seen &= (p_left - c) @ n > -BEHIND_SURFACE_M
         out = []
-        for k in np.flatnonzero(_in_either_image(self.true_stereo, p_left, n_left)):
+        for k in np.flatnonzero(seen):
             out.append(MarkerPatch(int(mt.codes[k]), p_left[k], n_left[k], mt.diameters_m[k]))
         return out
 
@@ -220,6 +232,8 @@ class SimCamera:
         """Nothing to release."""
 
 
+#: a hole scene's surface hides the markers more than this far behind it (m)
+BEHIND_SURFACE_M = 2e-3
 #: a marker is drawn when seen this close to face-on (rad) by the left camera
 MARKER_RENDER_ANGLE_RAD = np.radians(80.0)
 
