@@ -96,6 +96,8 @@ def inspect_hole(
     referenced = located is not None and located.referenced
     T_cell_left = (located.resection.T_cell_left if referenced
                    else T_cell_tcp(arm, model, q_rad, temps_c) @ T_head_left)  # fmt: skip
+    if located is not None and not referenced and located.T_cell_left_registered is not None:
+        T_cell_left = located.T_cell_left_registered  # the arm, in the markers' frame
     T_part_left = T_part_cell @ T_cell_left
     T_nom = T_part_cell @ arm.fk(q_rad, "tcp") @ T_head_left
     center_nominal_fk = ctx.part.to_20c(T_nom[:3, :3] @ meas.center_m + T_nom[:3, 3])

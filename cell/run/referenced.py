@@ -66,6 +66,17 @@ class ArmRegistration:
         self.arm.append(self._points(T_cell_left_arm))
         self.markers.append(self._points(T_cell_left_markers))
 
+    def transform(self) -> Array | None:
+        """The rigid motion (4, 4) taking the arm's cell frame into the markers' (None before
+        :data:`MIN_REGISTRATION_STOPS`): a stop that falls back to the arm is carried through
+        it, so that its hole is in the same frame as the referenced ones."""
+        if len(self.arm) < MIN_REGISTRATION_STOPS:
+            return None
+        R, t, _ = kabsch(np.vstack(self.arm), np.vstack(self.markers)[None])
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = R[0], t[0]
+        return T
+
     def residual_m(self, T_cell_left_arm: Array, T_cell_left_markers: Array) -> float:
         """Largest distance (m) of the stop's points after registering the arm to the markers
         on the stops so far (NaN before :data:`MIN_REGISTRATION_STOPS`)."""
@@ -89,6 +100,9 @@ class LocatedStop:
     disagreement_m: float
     disagreement_rad: float
     registered_m: float = math.nan
+    #: a stop that fell back: the arm's pose carried into the markers' frame (None: too few
+    #: referenced stops before it to register the arm; the arm's own frame is used)
+    T_cell_left_registered: Array | None = None
 
     @property
     def referenced(self) -> bool:
@@ -119,6 +133,7 @@ class LocatedStop:
                     "T_cell_left_arm": self.T_cell_left_arm.tolist()}  # fmt: skip
         else:
             out["reason"] = r.reason
+            out["registered_arm"] = self.T_cell_left_registered is not None
         return out
 
 

@@ -317,6 +317,8 @@ class Runner(ReferencePhase):
             exclude = label_circles(dets)
             if self.markers is not None:
                 located = locate_stop(self.markers, dets, T_arm, stop.hole_id)
+                if not located.referenced and (T_reg := self.registration.transform()) is not None:
+                    located = replace(located, T_cell_left_registered=T_reg @ T_arm)
                 if located.referenced:
                     T_res = located.resection.T_cell_left
                     located = replace(
