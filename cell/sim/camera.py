@@ -12,8 +12,8 @@ The reference markers in front of the head (at their true places,
 :attr:`cell.sim.world.SimWorld.markers`) are drawn into hole scenes and reference scenes; a view
 with markers and neither a hole nor the plate (a survey view) renders them with
 :func:`measure.synth.markers.render_markers_pair`. A hole scene's surface (a plane across the
-whole image) hides the markers behind it; otherwise the part does not hide a marker, and a view
-of the plate shows no marker.
+whole image) hides the markers more than 0.1 m behind it; otherwise the part does not hide a
+marker, and a view of the plate shows no marker.
 """
 
 from __future__ import annotations
@@ -232,8 +232,10 @@ class SimCamera:
         """Nothing to release."""
 
 
-#: a hole scene's surface hides the markers more than this far behind it (m)
-BEHIND_SURFACE_M = 2e-3
+#: a hole scene's surface hides the markers more than this far behind it (m): the table and
+#: the far side of the frame (T14 lies 0.43 m behind CTL's plane), not the neighbouring faces of
+#: the same part (CUL's shared markers lie 62-84 mm behind its plane)
+BEHIND_SURFACE_M = 0.1
 #: a marker is drawn when seen this close to face-on (rad) by the left camera
 MARKER_RENDER_ANGLE_RAD = np.radians(80.0)
 
