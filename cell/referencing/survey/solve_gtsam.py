@@ -130,6 +130,11 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     n_obs = 2 * len(problem.uv) + len(problem.bars)
     dof = max(n_obs - 6 * problem.n_views - 3 * problem.n_markers - 24, 1)
     if opt.iterations() == 0 and 2.0 * graph.error(result) / dof > STUCK_VARIANCE_FACTOR:
+        # Cholesky could not factor the normal equations: QR, slower, factors the system itself
+        params.setLinearSolverType("MULTIFRONTAL_QR")
+        opt = gtsam.LevenbergMarquardtOptimizer(graph, values, params)
+        result = opt.optimize()
+    if opt.iterations() == 0 and 2.0 * graph.error(result) / dof > STUCK_VARIANCE_FACTOR:
         raise SurveyRefusedError(
             "the adjustment", "could not move from its start (an ill-posed network)"
         )
@@ -140,7 +145,12 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     chi2 = 2.0 * graph.error(result)
     cov, head_cov = None, None
     if covariance:
-        marginals = gtsam.Marginals(graph, result)
+        try:
+            marginals = gtsam.Marginals(graph, result)
+        except RuntimeError as exc:  # gtsam's IndeterminateSystemException
+            raise SurveyRefusedError("the adjustment's covariance",
+                                     f"the network is ill-conditioned ({str(exc).strip()[:80]})"
+                                     ) from None  # fmt: skip
         keys = gtsam.KeyVector()
         for j in range(problem.n_markers):
             keys.append(L(j))
