@@ -39,6 +39,7 @@ from cell.referencing.resection import resect
 from cell.referencing.survey.gauge import rigid_fit, to_gauge
 from cell.referencing.survey.plan import survey_views
 from cell.referencing.survey.problem import build_problem
+from cell.referencing.survey.select import SelectOptions, select_cell_views
 from cell.referencing.survey.solve_scipy import solve_scipy
 from cell.referencing.survey.survey import SurveyOptions, survey
 from cell.referencing.synthetic import draw_marker_truth, observe
@@ -83,7 +84,10 @@ def run_seed(seed: int, args, cell, stereo) -> dict:
     mt = draw_marker_truth(cell, seed, 3e-4, truth.part_placement_error)
     rng = np.random.default_rng([seed, 77])
     views = []
-    for vid, T_plan in survey_views(cell, stereo):
+    planned = survey_views(cell, stereo)
+    if args.min_views > 0:
+        planned = select_cell_views(cell, stereo, planned, SelectOptions(min_views=args.min_views))
+    for vid, T_plan in planned:
         T_true = _perturbed(T_plan, rng, args.arm_mm * args.arm_x, args.arm_deg * args.arm_x)
         views.append(observe(mt, head, T_true, vid, args.sigma_px, rng, T_plan))
     t0 = time.perf_counter()
@@ -238,6 +242,12 @@ def main() -> None:
     ap.add_argument("--arm-deg", type=float, default=0.02, help="arm error of a view (deg)")
     ap.add_argument("--arm-x", type=float, default=1.0, help="multiply the arm's errors")
     ap.add_argument("--reference", action="store_true", help="also solve with SciPy (slow)")
+    ap.add_argument(
+        "--min-views",
+        type=int,
+        default=8,
+        help="views per marker the survey's views are chosen for (0: all planned)",
+    )
     args = ap.parse_args()
     cell = load_builtin_cell()
     stereo = cell_stereo(cell)

@@ -118,8 +118,8 @@ def run(args: argparse.Namespace) -> int:
     from cell.calibration.plan import calibrate_plan_options, plan_cell_calibration
     from cell.camera import NetworkCamera, cell_stereo
     from cell.commands.calibrate_report import print_result
+    from cell.commands.controller_check import connect_checked
     from cell.config import load_cell
-    from cell.errors import CellError
     from cell.link.client import ControllerClient
     from planner.calibration import load_caltour
 
@@ -151,10 +151,7 @@ def run(args: argparse.Namespace) -> int:
     client = ControllerClient(args.port)
     camera = None
     try:
-        client.connect()
-        if client.identity.robot_model != cell.robot.model:
-            raise CellError(f"controller at {args.port} drives {client.identity.robot_model!r}, "
-                            f"the cell has {cell.robot.model!r}")  # fmt: skip
+        connect_checked(client, args.port, cell.robot.model)
         camera = NetworkCamera(args.camera, stereo)
         done = run_calibration_tour(cell, tour, client, camera, options, _progress(args.quiet),
                                     source)  # fmt: skip

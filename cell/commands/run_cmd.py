@@ -24,6 +24,7 @@ from cell.commands.argtypes import (
     positive_float,
     temperature_u_K,
 )
+from cell.commands.controller_check import connect_checked
 from cell.commands.controller_cmd import (
     add_rws_arguments,
     add_rws_trigger_argument,
@@ -290,12 +291,7 @@ def run_run(args: argparse.Namespace) -> int:
     client = watched_client(ControllerClient(args.port), args)
     camera = recorder = files = None
     try:
-        client.connect()
-        if client.identity.robot_model != cell.robot.model:
-            raise CellError(
-                f"controller at {args.port} drives {client.identity.robot_model!r}, "
-                f"the cell has {cell.robot.model!r}"
-            )
+        connect_checked(client, args.port, cell.robot.model)
         _clear_fault(client, args)
         if model is not None:
             check_model_sensors(model, len(client.status().temperatures_c), args.thermal)

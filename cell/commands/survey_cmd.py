@@ -87,15 +87,13 @@ def run(args: argparse.Namespace) -> int:
         f"{len(planned.left_out)} planned views out of reach or in collision",
         flush=True,
     )
+    from cell.commands.controller_check import connect_checked
     from cell.link.client import ControllerClient
 
     client = ControllerClient(args.port)
     camera = None
     try:
-        client.connect()
-        if client.identity.robot_model != cell.robot.model:
-            raise CellError(f"controller at {args.port} drives {client.identity.robot_model!r}, "
-                            f"the cell has {cell.robot.model!r}")  # fmt: skip
+        connect_checked(client, args.port, cell.robot.model)
         camera = open_camera(args.camera, stereo)
         done = run_survey(cell, planned, client, camera, stereo,
                           SurveyRunOptions(args.settle_s, args.sigma_px),

@@ -41,6 +41,11 @@ SKEW_SIGMA = 1e-6
 _H = 1e-7
 
 
+#: the rig ties tried in turn when GTSAM's Cholesky cannot factor the information matrix for the
+#: marginals (an IndeterminateSystemException near a right camera's pose): a looser tie lets
+#: each right camera move a little more, so the covariance can only grow (conservative)
+MARGINAL_TIE_SIGMAS = (1e-5, 1e-4)
+
 #: an adjustment that made no step and whose variance factor is above this is refused
 STUCK_VARIANCE_FACTOR = 100.0
 
@@ -94,7 +99,9 @@ def _priors(graph: gtsam.NonlinearFactorGraph, problem: SurveyProblem) -> None:
         graph.add(gtsam.RangeFactor3(L(b.i), L(b.j), b.length_m, noise))
 
 
-def _graph(problem: SurveyProblem) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Values]:
+def _graph(
+    problem: SurveyProblem, tie_sigma: float = RIG_TIE_SIGMA
+) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Values]:
     graph = gtsam.NonlinearFactorGraph()
     values = gtsam.Values()
     pix = gtsam.noiseModel.Isotropic.Sigma(2, problem.sigma_px)
@@ -103,7 +110,7 @@ def _graph(problem: SurveyProblem) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Va
         pose = X(v) if s == 0 else Y(v)
         uv = problem.uv[k].reshape(2, 1)
         graph.add(gtsam.GeneralSFMFactor2Cal3DS2(uv, pix, pose, L(j), C(s)))
-    tie = gtsam.noiseModel.Isotropic.Sigma(6, RIG_TIE_SIGMA)
+    tie = gtsam.noiseModel.Isotropic.Sigma(6, tie_sigma)
     for v in range(problem.n_views):
         graph.add(gtsam.CustomFactor(tie, [X(v), Y(v), R(0)], _rig_error))
         values.insert(X(v), gtsam.Pose3(problem.poses0[v]))
@@ -145,12 +152,7 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     chi2 = 2.0 * graph.error(result)
     cov, head_cov = None, None
     if covariance:
-        try:
-            marginals = gtsam.Marginals(graph, result)
-        except RuntimeError as exc:  # gtsam's IndeterminateSystemException
-            raise SurveyRefusedError("the adjustment's covariance",
-                                     f"the network is ill-conditioned ({str(exc).strip()[:80]})"
-                                     ) from None  # fmt: skip
+        marginals = _marginals(problem, graph, result)
         keys = gtsam.KeyVector()
         for j in range(problem.n_markers):
             keys.append(L(j))
@@ -158,3 +160,19 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
         cov = marginals.jointMarginalCovariance(keys).fullMatrix() * scale
         head_cov = tuple(marginals.marginalCovariance(k) * scale for k in (C(0), C(1), R(0)))
     return RawSolution(points, poses, cov, chi2, dof, int(opt.iterations()), head, head_cov)
+
+
+def _marginals(
+    problem: SurveyProblem, graph: gtsam.NonlinearFactorGraph, result: gtsam.Values
+) -> gtsam.Marginals:
+    """GTSAM's marginals at ``result``; when Cholesky cannot factor the tightly tied graph, the
+    same graph with a looser rig tie (:data:`MARGINAL_TIE_SIGMAS`); refused when none factors."""
+    error = ""
+    for tie in (None, *MARGINAL_TIE_SIGMAS):
+        g = graph if tie is None else _graph(problem, tie)[0]
+        try:
+            return gtsam.Marginals(g, result)
+        except RuntimeError as exc:  # gtsam's IndeterminateSystemException
+            error = str(exc).strip().splitlines()[0][:120]
+    raise SurveyRefusedError("the adjustment's covariance",
+                             f"the network is ill-conditioned ({error})")  # fmt: skip

@@ -7,7 +7,8 @@ arm cannot reach, or only in collision, is tried again turned about its view axi
 and 180° (the same markers, seen from the same direction, with the wrist elsewhere); one that
 still cannot be reached is left out and named; the survey's refusals (a marker in
 fewer than 3 views, rays meeting at less than 20°, a network in pieces) then judge what remains.
-A stop's ``hole_id`` is the view's id.
+Of the reachable views only the fewest that see every marker often enough from directions well
+apart are driven (:mod:`cell.referencing.survey.select`). A stop's ``hole_id`` is the view's id.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from numpy.typing import NDArray
 from cell.config import CellConfig
 from cell.referencing.errors import SurveyRefusedError
 from cell.referencing.survey.plan import SurveyPlanOptions, survey_views
+from cell.referencing.survey.select import SelectOptions, select_cell_views
 from measure import StereoCalibration
 from measure.head import head_frame
 from planner import Options, Tour
@@ -29,6 +31,9 @@ from planner.viewpoints import HoleCandidates
 
 Array = NDArray[np.float64]
 
+
+#: the views driven by default: :class:`SelectOptions`' defaults
+DEFAULT_SELECT = SelectOptions()
 
 #: turns about the view axis tried, in this order, until the arm reaches the view (rad)
 ROLLS_RAD = (0.0, np.pi / 2, -np.pi / 2, np.pi)
@@ -76,9 +81,11 @@ def plan_survey_tour(
     plan: SurveyPlanOptions | None = None,
     options: Options | None = None,
     progress: ProgressCallback | None = None,
+    select: SelectOptions | None = DEFAULT_SELECT,
 ) -> SurveyTour:
     """The survey tour of ``cell`` with head ``stereo`` (module doc); refused when no view is
-    reachable."""
+    reachable. ``select``: of the reachable views, drive only those
+    :func:`cell.referencing.survey.select.select_cell_views` chooses (None: all of them)."""
     arm = cell.build_arm()
     T_left_head = head_frame(stereo)  # the head (TCP) in the left camera frame
     groups, poses, left_out = [], {}, {}
@@ -92,6 +99,10 @@ def plan_survey_tour(
                 break
         else:
             left_out[vid] = why
+    if select is not None and groups:
+        chosen = {vid for vid, _ in select_cell_views(cell, stereo, list(poses.items()), select)}
+        groups = [g for g in groups if g.hole_id in chosen]
+        poses = {vid: T for vid, T in poses.items() if vid in chosen}
     if not groups:
         raise SurveyRefusedError("survey tour", "no survey view is reachable without collision")
     tour = ViewTourPlanner(groups, options, progress).plan(cell)
