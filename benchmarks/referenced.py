@@ -132,6 +132,8 @@ def run_seed(seed: int, args, cell, stereo) -> dict:
 def _holes(seed, args, cell, stereo, world, head, mt, res, rng) -> dict:
     T_cell_part = cell.T_cell_part()
     T_part_cell = invert(T_cell_part)
+    w_net, v_net = np.linalg.eigh(0.5 * (res.covariance + res.covariance.T))
+    L_net = v_net * np.sqrt(np.clip(w_net, 0.0, None))  # the network's error: L_net z
     results, t_res, fallback = [], [], 0
     measured_with = res.stereo or stereo  # the head as the survey self-calibrated it
     for i, h in enumerate(cell.part.holes):
@@ -164,7 +166,20 @@ def _holes(seed, args, cell, stereo, world, head, mt, res, rng) -> dict:
         cov_fit = np.asarray(meas.cov_center_radius, float)[:3, :3]
         p_cell, cov_cell = r.point(meas.center_m, cov_fit)
         p_part = T_part_cell[:3, :3] @ p_cell + T_part_cell[:3, 3]
-        cov_part = T_part_cell[:3, :3] @ cov_cell @ T_part_cell[:3, :3].T
+        R_pc = T_part_cell[:3, :3]
+        cov_part = R_pc @ cov_cell @ R_pc.T
+        # the components as a run stores them: the survey's error shared through its factor
+        J = R_pc @ r.point_jacobian(meas.center_m)
+        R_pl = R_pc @ r.T_cell_left[:3, :3]
+        cols = np.asarray(r.marker_columns, np.int64)
+        F = J @ r.marker_sensitivity @ L_net[(3 * cols[:, None] + np.arange(3)).ravel()]
+        parts = {
+            "circle_fit": R_pl @ cov_fit @ R_pl.T,
+            "resection": J @ (r.covariance - r.covariance_markers) @ J.T,
+            "survey_markers": J @ r.covariance_markers @ J.T,
+        }
+        if args.independent_markers:
+            F = None
         results.append(
             HoleResult(
                 hole_id=h.id,
@@ -178,7 +193,12 @@ def _holes(seed, args, cell, stereo, world, head, mt, res, rng) -> dict:
                 diameter_m=float(meas.diameter_m),
                 rms_m=0.0,
                 U_diameter_m=float(2 * 2 * np.sqrt(max(meas.cov_center_radius[3][3], 0.0))),
-                extra={"cov_center_part_m2": cov_part.tolist()},
+                extra={
+                    "cov_center_part_m2": cov_part.tolist(),
+                    "cov_components_part_m2": {k: v.tolist() for k, v in parts.items()},
+                    "R_part_left": R_pl.tolist(),
+                }
+                | ({} if F is None else {"survey_markers_factor_part": F.tolist()}),
             )
         )
     centres = {
@@ -243,9 +263,14 @@ def main() -> None:
     ap.add_argument("--arm-x", type=float, default=1.0, help="multiply the arm's errors")
     ap.add_argument("--reference", action="store_true", help="also solve with SciPy (slow)")
     ap.add_argument(
+        "--independent-markers",
+        action="store_true",
+        help="draw the survey's marker errors independently per stop (the old way)",
+    )
+    ap.add_argument(
         "--min-views",
         type=int,
-        default=8,
+        default=6,
         help="views per marker the survey's views are chosen for (0: all planned)",
     )
     args = ap.parse_args()

@@ -8,9 +8,14 @@ each hole, :func:`gdt_extra`). The components are drawn as they act in a run:
 - ``circle_fit``, ``robot_repeatability`` and ``thermal_model``: independently per hole (the
   thermal model's error varies with the pose; taken as independent, which overstates what a
   common part of it does to an alignment);
-- ``resection`` and ``survey_markers`` (a referenced stop): independently per hole (stops that
-  share markers share part of the survey's error; drawn as independent, which overstates it
-  for a datum frame);
+- ``resection`` (a referenced stop): independently per hole (each stop's own image noise);
+- ``survey_markers`` (a referenced stop): one error of the whole marker network for the run,
+  ``z ~ N(0, I_3N)``, mapped into each hole's centre through the factor the run stored with it
+  (``survey_markers_factor_part``, 3 x 3N: the hole's sensitivity to the markers through its
+  stop's resection times a square root of the network's covariance). Stops that share markers
+  then share their error, as they do: drawn independently, the datum features' marker errors
+  would turn the datum frame and swing the far holes by their levers (five to ten times the
+  real scatter on the built-in frame). Without the factor: independently per hole;
 - ``stereo_calibration``: one error of the head for the whole run (the head is off its
   calibration by the same amount at every stop): one standard normal draw per run, mapped into
   each hole's centre through its own covariance in the left camera frame and that stop's
@@ -90,14 +95,17 @@ def _chol(S: np.ndarray) -> np.ndarray:
 
 
 def _error_draws(r: HoleResult, z_cal: np.ndarray, z_temp: np.ndarray, rng: np.random.Generator,
-                 z_cell: _SharedDraws | None = None) -> np.ndarray:  # fmt: skip
+                 z_cell: _SharedDraws | None = None,
+                 z_net: _SharedDraws | None = None) -> np.ndarray:  # fmt: skip
     """Draws ``(n, 3)`` of a centre's error (m), see the module doc."""
     n = len(z_temp)
     parts = r.extra.get("cov_components_part_m2")
     if parts is None or "R_part_left" not in r.extra:
         return rng.standard_normal((n, 3)) @ _chol(centre_cov(r)).T
-    indep = sum((np.asarray(parts[k], float) for k in INDEPENDENT if k in parts),
-                np.zeros((3, 3)))  # fmt: skip
+    shared = r.extra.get("survey_markers_factor_part") if z_net is not None else None
+    indep_keys = [k for k in INDEPENDENT if k in parts
+                  and not (k == "survey_markers" and shared is not None)]  # fmt: skip
+    indep = sum((np.asarray(parts[k], float) for k in indep_keys), np.zeros((3, 3)))
     err = rng.standard_normal((n, 3)) @ _chol(indep).T
     if "stereo_calibration" in parts:
         R = np.asarray(r.extra["R_part_left"], float)
@@ -112,6 +120,9 @@ def _error_draws(r: HoleResult, z_cal: np.ndarray, z_temp: np.ndarray, rng: np.r
     if A is not None and "cell_calibration" in parts and z_cell is not None:
         A = np.asarray(A, float)
         err += z_cell.get(A.shape[1]) @ A.T
+    if shared is not None:
+        F = np.asarray(shared, float)
+        err += z_net.get(F.shape[1]) @ F.T
     return err
 
 
@@ -119,13 +130,14 @@ class _SharedDraws:
     """Standard normal draws ``(n, p)`` shared by every hole of a run (one per dimension
     ``p``), from their own stream so runs without them draw as before."""
 
-    def __init__(self, n: int, seed: int) -> None:
-        self.n, self.seed = n, seed
+    def __init__(self, n: int, seed: int, stream: int = 18) -> None:
+        self.n, self.seed, self.stream = n, seed, stream
         self._z: dict[int, np.ndarray] = {}
 
     def get(self, p: int) -> np.ndarray:
         if p not in self._z:
-            self._z[p] = np.random.default_rng([self.seed, 18, p]).standard_normal((self.n, p))
+            rng = np.random.default_rng([self.seed, self.stream, p])
+            self._z[p] = rng.standard_normal((self.n, p))
         return self._z[p]
 
 
@@ -134,13 +146,13 @@ def draw_centres(results: list[HoleResult], n: int, seed: int) -> dict[str, np.n
     first draw of each is the measured value itself (the estimate)."""
     rng = np.random.default_rng(seed)
     z_cal, z_temp = rng.standard_normal((n, 3)), rng.standard_normal(n)
-    z_cell = _SharedDraws(n, seed)
+    z_cell, z_net = _SharedDraws(n, seed), _SharedDraws(n, seed, 25)
     out = {}
     for r in results:
         if not r.measured:
             continue
         c = np.asarray(r.center_part_m, float)
-        d = c + _error_draws(r, z_cal, z_temp, rng, z_cell)
+        d = c + _error_draws(r, z_cal, z_temp, rng, z_cell, z_net)
         d[0] = c
         out[r.hole_id] = d
     return out

@@ -5,6 +5,7 @@ the detector and the resection need of each marker (its code, nominal normal and
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +43,14 @@ class MarkerNetwork:
 
     def index(self, marker_id: str) -> int:
         return self.ids.index(marker_id)
+
+    @cached_property
+    def covariance_root(self) -> Array:
+        """``L`` (3n, 3n) m with ``L L^T = covariance``: the network's error is ``L z``,
+        ``z ~ N(0, I)`` (symmetric eigen-decomposition; negative rounding clipped)."""
+        C = np.asarray(self.covariance, float)
+        w, v = np.linalg.eigh(0.5 * (C + C.T))
+        return v * np.sqrt(np.clip(w, 0.0, None))
 
 
 def load_network(

@@ -47,6 +47,11 @@ class Resection:
     rms_px: float = float("nan")
     reason: str = ""
     covariance_markers: Array | None = None
+    #: d (w, tau) / d (the used markers' positions) (6, 3k), and the markers' indices in the
+    #: network (k,): how the survey's marker errors move this stop (shared by the stops that
+    #: use the same markers)
+    marker_sensitivity: Array | None = None
+    marker_columns: tuple[int, ...] = ()
 
     def point_jacobian(self, p_left: Array) -> Array:
         """d p_cell / d (w, tau) (3, 6) of a point ``p_left`` (m) of the left camera frame."""
@@ -144,15 +149,16 @@ def resect(
     JtJ_inv = np.linalg.inv(J.T @ J)
     cov = JtJ_inv.copy()
     cov_markers = np.zeros((6, 6))
+    A, cols = None, np.unique(obs.marker)
     if covariance is not None:
         Jm = _marker_jacobian(sol.x, args)
-        cols = np.unique(obs.marker)
         idx = (3 * cols[:, None] + np.arange(3)).ravel()
         A = JtJ_inv @ J.T @ Jm[:, idx]
         cov_markers = A @ covariance[np.ix_(idx, idx)] @ A.T
         cov = cov + cov_markers
     rms = float(np.sqrt(np.mean((r * sigma_px) ** 2)))
-    return Resection(True, T, cov, tuple(used), refused, rms, "", cov_markers)
+    return Resection(True, T, cov, tuple(used), refused, rms, "", cov_markers, A,
+                     tuple(int(c) for c in cols))  # fmt: skip
 
 
 def _marker_jacobian(x: Array, args: tuple) -> Array:

@@ -22,7 +22,7 @@ from cell.calibration.use import RunGeometry
 from cell.config import CellConfig, HoleInCell
 from cell.gdt.montecarlo import gdt_extra
 from cell.records.hole_result import HoleResult, deviations
-from cell.run.referenced import LocatedStop, referenced_contributions
+from cell.run.referenced import LocatedStop, referenced_contributions, survey_markers_factor
 from cell.uncertainty.budget import combine
 from cell.uncertainty.context import BudgetContext, budget_context, hole_contributions
 from cell.uncertainty.decision import decide_hole, decide_one
@@ -124,6 +124,10 @@ def inspect_hole(
     extra = {**result.extra, **gdt_extra(contributions, T_part_left)}
     if cal_A is not None:  # the shared calibration error's factor, for the datum-frame draws
         extra["cell_calibration_factor_part"] = cal_A.tolist()
+    net_F = None if located is None else survey_markers_factor(located, meas.center_m,
+                                                                T_part_cell[:3, :3])  # fmt: skip
+    if net_F is not None:  # the shared network error's factor, for the datum-frame draws
+        extra["survey_markers_factor_part"] = net_F.tolist()
     result = replace(result, extra=extra)
     return _decided(result, budget, ctx.rule), meas
 

@@ -100,6 +100,9 @@ class LocatedStop:
     disagreement_m: float
     disagreement_rad: float
     registered_m: float = math.nan
+    #: d (w, tau) / d z (6, 3n): the stop's pose error for the network's error ``L z``
+    #: (:attr:`MarkerNetwork.covariance_root`); None without a network covariance
+    marker_factor: Array | None = None
     #: a stop that fell back: the arm's pose carried into the markers' frame (None: too few
     #: referenced stops before it to register the arm; the arm's own frame is used)
     T_cell_left_registered: Array | None = None
@@ -156,7 +159,24 @@ def locate_stop(
         D = np.linalg.inv(T_cell_left_arm) @ r.T_cell_left
         dt = float(np.linalg.norm(r.T_cell_left[:3, 3] - T_cell_left_arm[:3, 3]))
         dr = float(np.arccos(np.clip((np.trace(D[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)))
-    return LocatedStop(r, view, np.asarray(T_cell_left_arm, float), dt, dr)
+    factor = None
+    if r.ok and r.marker_sensitivity is not None:
+        cols = np.asarray(r.marker_columns, np.int64)
+        rows = (3 * cols[:, None] + np.arange(3)).ravel()
+        factor = r.marker_sensitivity @ network.covariance_root[rows]
+    return LocatedStop(r, view, np.asarray(T_cell_left_arm, float), dt, dr, marker_factor=factor)
+
+
+def survey_markers_factor(
+    located: LocatedStop, center_left_m: Array, R_part_cell: Array
+) -> Array | None:
+    """The hole centre's error in the part frame for the network's error ``L z`` (3, 3n) m:
+    the stops that share markers share it (:mod:`cell.gdt.montecarlo`); None when the stop is
+    not referenced or the network has no covariance."""
+    if not located.referenced or located.marker_factor is None:
+        return None
+    J = R_part_cell @ located.resection.point_jacobian(center_left_m)
+    return J @ located.marker_factor
 
 
 def referenced_contributions(

@@ -40,9 +40,10 @@ Array = NDArray[np.float64]
 class SelectOptions:
     """``min_views``: views per marker (the issue asks 4; the survey refuses below 3);
     ``min_angle_rad``: the widest angle between a marker's rays (the survey refuses below
-    20 deg); ``min_markers``: a view seeing fewer is never taken (the survey could not locate it)."""
+    20 deg); ``min_markers``: a view seeing fewer is never taken (the survey could not
+    locate it)."""
 
-    min_views: int = 8
+    min_views: int = 6
     min_angle_rad: float = math.radians(35.0)
     min_markers: int = 4
 
