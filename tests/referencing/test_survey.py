@@ -146,3 +146,28 @@ def test_the_self_calibrated_head_carries_the_adjustments_uncertainty(surveyed, 
     assert u is not None and "survey" in u.method
     assert np.all(u.K_std_left_px < d.K_std_left_px) and np.all(u.T_std_m < d.T_std_m)
     assert u.dist_std_left[4] == d.dist_std_left[4]
+
+
+def test_the_dense_covariance_agrees_with_gtsams_marginals(small_cell, stereo, surveyed,
+                                                           marker_truth):  # fmt: skip
+    """The fall-back when GTSAM's Cholesky cannot factor a network: the same information
+    matrix, scaled and factored densely, gives the same marginals."""
+    import gtsam
+
+    from cell.referencing.survey import solve_gtsam as sg
+
+    views, _ = surveyed
+    ids = list(marker_truth.ids)
+    bars = [(b.from_, b.to, b.length_m, b.U_m) for b in small_cell.scale_bars]
+    kept, _ = usable_views(views, ids, marker_truth.nominal)
+    problem = build_problem(kept, stereo, ids, marker_truth.nominal, bars, 0.05)
+    graph, values = sg._graph(problem)
+    result = gtsam.LevenbergMarquardtOptimizer(graph, values).optimize()
+    gt_cov, gt_head = sg._covariances(problem, graph, result)
+    de_cov, de_head = sg._dense_covariances(problem, graph, result)
+    sd = np.sqrt(np.diag(gt_cov))
+    assert np.abs(np.sqrt(np.diag(de_cov)) / sd - 1.0).max() < 1e-3
+    corr = lambda C: C / np.sqrt(np.outer(np.diag(C), np.diag(C)))  # noqa: E731
+    assert np.abs(corr(de_cov) - corr(gt_cov)).max() < 1e-3
+    for a, b in zip(gt_head, de_head, strict=True):
+        assert np.abs(np.sqrt(np.diag(b)) / np.sqrt(np.diag(a)) - 1.0).max() < 1e-3

@@ -23,6 +23,7 @@ from __future__ import annotations
 import gtsam
 import numpy as np
 from gtsam.symbol_shorthand import C, L, R, X, Y
+from scipy.linalg import cho_factor, cho_solve
 
 from cell.referencing.errors import SurveyRefusedError
 from cell.referencing.survey.problem import Array, SurveyProblem
@@ -40,11 +41,6 @@ SKEW_SIGMA = 1e-6
 #: the numerical step of the rig factor's Jacobians (rad, m)
 _H = 1e-7
 
-
-#: the rig ties tried in turn when GTSAM's Cholesky cannot factor the information matrix for the
-#: marginals (an IndeterminateSystemException near a right camera's pose): a looser tie lets
-#: each right camera move a little more, so the covariance can only grow (conservative)
-MARGINAL_TIE_SIGMAS = (1e-5, 1e-4)
 
 #: an adjustment that made no step and whose variance factor is above this is refused
 STUCK_VARIANCE_FACTOR = 100.0
@@ -152,27 +148,57 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     chi2 = 2.0 * graph.error(result)
     cov, head_cov = None, None
     if covariance:
-        marginals = _marginals(problem, graph, result)
-        keys = gtsam.KeyVector()
-        for j in range(problem.n_markers):
-            keys.append(L(j))
         scale = max(1.0, chi2 / dof)
-        cov = marginals.jointMarginalCovariance(keys).fullMatrix() * scale
-        head_cov = tuple(marginals.marginalCovariance(k) * scale for k in (C(0), C(1), R(0)))
+        cov, head_cov = _covariances(problem, graph, result)
+        cov, head_cov = cov * scale, tuple(c * scale for c in head_cov)
     return RawSolution(points, poses, cov, chi2, dof, int(opt.iterations()), head, head_cov)
 
 
-def _marginals(
+def _covariances(
     problem: SurveyProblem, graph: gtsam.NonlinearFactorGraph, result: gtsam.Values
-) -> gtsam.Marginals:
-    """GTSAM's marginals at ``result``; when Cholesky cannot factor the tightly tied graph, the
-    same graph with a looser rig tie (:data:`MARGINAL_TIE_SIGMAS`); refused when none factors."""
-    error = ""
-    for tie in (None, *MARGINAL_TIE_SIGMAS):
-        g = graph if tie is None else _graph(problem, tie)[0]
-        try:
-            return gtsam.Marginals(g, result)
-        except RuntimeError as exc:  # gtsam's IndeterminateSystemException
-            error = str(exc).strip().splitlines()[0][:120]
-    raise SurveyRefusedError("the adjustment's covariance",
-                             f"the network is ill-conditioned ({error})")  # fmt: skip
+) -> tuple[Array, tuple[Array, Array, Array]]:
+    """The markers' joint covariance (3n, 3n) and the head's (both calibrations, the rig) at
+    ``result``: GTSAM's marginals, or, when its Cholesky cannot factor the graph (the rig tie
+    and the skew prior weigh 1e12 against the pixels' 1e2-1e3: an IndeterminateSystemException
+    on some networks), the same information matrix dense, scaled to a unit diagonal and
+    factored by SciPy (:func:`_dense_covariances`); refused when neither factors."""
+    keys = gtsam.KeyVector()
+    for j in range(problem.n_markers):
+        keys.append(L(j))
+    try:
+        marginals = gtsam.Marginals(graph, result)
+        cov = marginals.jointMarginalCovariance(keys).fullMatrix()
+        return cov, tuple(marginals.marginalCovariance(k) for k in (C(0), C(1), R(0)))
+    except RuntimeError:  # gtsam's IndeterminateSystemException
+        return _dense_covariances(problem, graph, result)
+
+
+def _dense_covariances(
+    problem: SurveyProblem, graph: gtsam.NonlinearFactorGraph, result: gtsam.Values
+) -> tuple[Array, tuple[Array, Array, Array]]:
+    """:func:`_covariances` from the dense information matrix ``H`` (markers, calibrations and
+    rig first): ``D^-1/2 H D^-1/2`` (``D`` its diagonal) by Cholesky, then the first columns of
+    its inverse."""
+    n, nv = problem.n_markers, problem.n_views
+    order = gtsam.Ordering()
+    for k in [L(j) for j in range(n)] + [C(0), C(1), R(0)]:
+        order.push_back(k)
+    for v in range(nv):
+        order.push_back(X(v))
+        order.push_back(Y(v))
+    H, _ = graph.linearize(result).hessian(order)
+    d = np.sqrt(np.clip(np.diag(H), 1e-300, None))
+    try:
+        factor = cho_factor(H / d[:, None] / d[None, :])
+    except np.linalg.LinAlgError:
+        raise SurveyRefusedError(
+            "the adjustment's covariance", "the network's information matrix is singular"
+        ) from None
+    m = 3 * n + 24  # the markers, the two calibrations (9 each) and the rig (6)
+    E = np.zeros((len(d), m))
+    E[np.arange(m), np.arange(m)] = 1.0
+    inv = cho_solve(factor, E)[:m] / d[:m, None] / d[None, :m]
+    inv = 0.5 * (inv + inv.T)
+    o = 3 * n
+    return inv[:o, :o], (inv[o : o + 9, o : o + 9], inv[o + 9 : o + 18, o + 9 : o + 18],
+                         inv[o + 18 :, o + 18 :])  # fmt: skip
