@@ -157,8 +157,9 @@ def format_survey(res: DemoResult) -> str:
     flagged = sum(1 for x in refs if (x.get("arm_registered_m") or 0.0) > 1e-3)
     rows = [
         ("marker survey", f"{len(r.marker_ids)} markers from {r.n_views} views, "
-                          f"{r.rms_px:.3f} px RMS, {v.robot_time_s:.0f} s robot time, "
-                          f"{v.seconds:.1f} s"),
+                          f"{r.rms_px:.3f} px RMS, {v.planned_robot_time_s:.0f} s robot time "
+                          f"planned ({v.robot_time_s:.0f} s on the simulator's clock, which "
+                          f"runs while each pair renders), {v.seconds:.1f} s"),
         ("  vs true markers", f"{v.rms_m * 1e6:.1f} um RMS (max {v.worst_m * 1e6:.1f} um) after "
                               f"a rigid fit; scale sigma {r.scale_sigma_ppm:.1f} ppm"),
         ("  stops referenced", f"{n_ref}/{len(refs)} located against the markers"

@@ -39,6 +39,9 @@ class DemoSurvey:
     scale_error_ppm: float = float("nan")
     within_2sigma: float = float("nan")
     plan_cache: str = ""
+    #: the survey tour's planned robot time (s): motion and the 0.2 s settle per view; the
+    #: simulator's clock (``robot_time_s``) also runs while each pair renders
+    planned_robot_time_s: float = float("nan")
 
 
 #: the source that decides the survey tour (its cache key)
@@ -111,4 +114,5 @@ def survey_demo_cell(
     z = np.abs(P - (true @ G[:3, :3].T + G[:3, 3])) / r.sigma_m()
     return DemoSurvey(path, r, time.perf_counter() - t0, done.captures.robot_time_s,
                       float(np.sqrt(np.mean(e**2))), float(e.max()), done.solve_s, float(scale),
-                      float(np.mean(z < 2.0)), planned.plan_cache)  # fmt: skip
+                      float(np.mean(z < 2.0)), planned.plan_cache,
+                      float(planned.tour.cycle_time_s))  # fmt: skip
