@@ -36,6 +36,7 @@ from cell.gdt.truth_check import coverage, true_evaluation
 from cell.records.hole_result import HoleResult
 from cell.referencing.layout import stop_pose
 from cell.referencing.resection import resect
+from cell.referencing.sigma import effective_sigma_px
 from cell.referencing.survey.gauge import rigid_fit, to_gauge
 from cell.referencing.survey.plan import survey_views
 from cell.referencing.survey.problem import build_problem
@@ -157,7 +158,13 @@ def _holes(seed, args, cell, stereo, world, head, mt, res, rng) -> dict:
         view = observe(mt, head, T_true, h.id, args.sigma_px, rng, T_plan)
         t0 = time.perf_counter()
         r = resect(
-            view, measured_with, res.marker_ids, res.positions_cell, res.covariance, args.sigma_px
+            view,
+            measured_with,
+            res.marker_ids,
+            res.positions_cell,
+            res.covariance,
+            args.sigma_px,
+            effective_sigma_px(args.sigma_px, res.variance_factor),
         )
         t_res.append(time.perf_counter() - t0)
         if not r.ok:

@@ -40,6 +40,10 @@ class MarkerNetwork:
     head: StereoCalibration
     source: str
     sigma_px: float = DEFAULT_SIGMA_PX
+    #: the centre noise the resection's covariance is stated at (px): the survey's a posteriori
+    #: figure, not below the floor (:mod:`cell.referencing.sigma`); the stated ``sigma_px``
+    #: still weighs the observations and sets the outlier limit
+    image_sigma_px: float = DEFAULT_SIGMA_PX
 
     def index(self, marker_id: str) -> int:
         return self.ids.index(marker_id)
@@ -74,5 +78,17 @@ def load_network(
     normals = np.array([marker_in_cell(by_id[m], T_cell_part)[1] for m in ids])
     radii = np.array([0.5 * by_id[m].diameter_m for m in ids])
     codes = {c: m for c, m in marker_codes(cell.reference_markers).items() if m in set(ids)}
+    figures = doc.get("figures") if isinstance(doc.get("figures"), dict) else {}
+    stated = _positive(figures.get("sigma_px"), DEFAULT_SIGMA_PX, src, "figures.sigma_px")
+    image = _positive(figures.get("sigma_effective_px"), stated, src, "figures.sigma_effective_px")
     return MarkerNetwork(ids, P, C, normals, radii, codes, head,
-                         f"{src} ({doc.get('created_utc')})")  # fmt: skip
+                         f"{src} ({doc.get('created_utc')})", stated, image)  # fmt: skip
+
+
+def _positive(value: object, default: float, src: str, field: str) -> float:
+    """``value`` as a positive number (``default`` when absent: a file written before it)."""
+    if value is None:
+        return default
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise MarkersFileError(src, field, f"must be a positive number of pixels, got {value!r}")
+    return float(value)

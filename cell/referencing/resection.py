@@ -121,9 +121,12 @@ def resect(
     positions: Array,
     covariance: Array | None,
     sigma_px: float,
+    image_sigma_px: float | None = None,
 ) -> Resection:
     """Locate ``view`` against the surveyed markers ``marker_ids`` (positions (n, 3) m, cell
-    frame; their covariance (3n, 3n) m² or None) (module doc)."""
+    frame; their covariance (3n, 3n) m² or None) (module doc). ``sigma_px`` weighs the centres
+    and sets the outlier limit; the image noise's covariance is stated at ``image_sigma_px``
+    (default ``sigma_px``; :mod:`cell.referencing.sigma`)."""
     index = {m: k for k, m in enumerate(marker_ids)}
     obs = _Obs(view, stereo, index)
     K = (np.asarray(stereo.K_left, float), np.asarray(stereo.K_right, float))
@@ -147,7 +150,7 @@ def resect(
     T = _pose(T0, sol.x)
     J = sol.jac
     JtJ_inv = np.linalg.inv(J.T @ J)
-    cov = JtJ_inv.copy()
+    cov = JtJ_inv * ((image_sigma_px or sigma_px) / sigma_px) ** 2
     cov_markers = np.zeros((6, 6))
     A, cols = None, np.unique(obs.marker)
     if covariance is not None:

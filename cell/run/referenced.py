@@ -153,7 +153,7 @@ def locate_stop(
     view = observe_detections(detections, network.head, network.codes, geometry, view_id,
                               T_cell_left_arm)  # fmt: skip
     r = resect(view, network.head, network.ids, network.positions_cell, network.covariance,
-               network.sigma_px)  # fmt: skip
+               network.sigma_px, network.image_sigma_px)  # fmt: skip
     dt, dr = math.nan, math.nan
     if r.ok:
         D = np.linalg.inv(T_cell_left_arm) @ r.T_cell_left

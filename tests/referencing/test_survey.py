@@ -171,3 +171,23 @@ def test_the_dense_covariance_agrees_with_gtsams_marginals(small_cell, stereo, s
     assert np.abs(corr(de_cov) - corr(gt_cov)).max() < 1e-3
     for a, b in zip(gt_head, de_head, strict=True):
         assert np.abs(np.sqrt(np.diag(b)) / np.sqrt(np.diag(a)) - 1.0).max() < 1e-3
+
+
+def test_the_covariances_are_stated_at_the_a_posteriori_noise_above_the_floor(
+    surveyed, small_cell, stereo, tmp_path: Path
+):
+    from cell.referencing.network import load_network
+    from cell.referencing.sigma import SIGMA_FLOOR_PX, effective_sigma_px
+
+    assert effective_sigma_px(0.05, (0.006 / 0.05) ** 2) == SIGMA_FLOOR_PX  # a clean render
+    assert np.isclose(effective_sigma_px(0.05, 4.0), 0.1)  # a detector worse than stated
+    _views, res = surveyed  # simulated at the stated 0.05 px: the variance factor is about 1
+    path = save_markers(tmp_path / "markers.json", res, small_cell, stereo)
+    net = load_network(path, small_cell, stereo)
+    assert net.sigma_px == 0.05
+    assert np.isclose(net.image_sigma_px, 0.05 * np.sqrt(res.variance_factor))
+    doc = json.loads(path.read_text())
+    doc["figures"]["sigma_effective_px"] = -1
+    path.write_text(json.dumps(doc))
+    with pytest.raises(MarkersFileError, match="figures.sigma_effective_px"):
+        load_network(path, small_cell, stereo)

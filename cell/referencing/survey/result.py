@@ -19,8 +19,9 @@ class SurveyResult:
     frame, in the gauge ``gauge`` (``"fixture markers"`` or ``"all markers"``: a rigid fit to
     their nominal positions, ``gauge_residuals_m`` their distances after it).
 
-    ``rms_px``: the image residual RMS (ideal pixels), ``variance_factor`` chi2 / dof (the
-    covariance is scaled by it when above 1); ``scale_sigma_ppm``: the network's scale
+    ``rms_px``: the image residual RMS (ideal pixels), ``variance_factor`` chi2 / dof,
+    ``sigma_px`` the centre noise stated (the covariance is stated at the a posteriori noise,
+    not below a floor: :mod:`cell.referencing.sigma`); ``scale_sigma_ppm``: the network's scale
     uncertainty (from the scale bars and the head's baseline), ``scale_source`` says which;
     ``dropped_views``: views left out (too few markers, or on one line); ``outliers``: the
     observations dropped above the outlier limit, as ``(view, marker, camera, normalised
@@ -43,6 +44,7 @@ class SurveyResult:
     outliers: tuple[tuple[str, str, str, float], ...] = ()
     warnings: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
+    sigma_px: float = 0.05
     stereo: StereoCalibration | None = None
 
     def sigma_m(self) -> Array:

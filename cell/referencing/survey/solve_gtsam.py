@@ -26,6 +26,7 @@ from gtsam.symbol_shorthand import C, L, R, X, Y
 from scipy.linalg import cho_factor, cho_solve
 
 from cell.referencing.errors import SurveyRefusedError
+from cell.referencing.sigma import covariance_scale
 from cell.referencing.survey.problem import Array, SurveyProblem
 from cell.referencing.survey.solution import RawSolution
 
@@ -122,7 +123,8 @@ def _graph(
 
 def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     """Adjust ``problem`` (module doc); ``covariance``: also the markers' joint covariance
-    (3n, 3n) m², scaled by the variance factor when that exceeds 1."""
+    (3n, 3n) m² and the head's, stated at the a posteriori centre noise, not below the floor
+    (:mod:`cell.referencing.sigma`)."""
     graph, values = _graph(problem)
     params = gtsam.LevenbergMarquardtParams()
     params.setRelativeErrorTol(1e-10)
@@ -148,7 +150,7 @@ def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
     chi2 = 2.0 * graph.error(result)
     cov, head_cov = None, None
     if covariance:
-        scale = max(1.0, chi2 / dof)
+        scale = covariance_scale(problem.sigma_px, chi2 / dof)
         cov, head_cov = _covariances(problem, graph, result)
         cov, head_cov = cov * scale, tuple(c * scale for c in head_cov)
     return RawSolution(points, poses, cov, chi2, dof, int(opt.iterations()), head, head_cov)

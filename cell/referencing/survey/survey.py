@@ -107,6 +107,7 @@ def survey(
         gauge_residuals_m=g.residuals_m,
         rms_px=float(np.sqrt(np.mean(res**2))),
         variance_factor=raw.variance_factor,
+        sigma_px=o.sigma_px,
         n_views=problem.n_views,
         n_observations=len(problem.uv),
         scale_sigma_ppm=scale_ppm,
