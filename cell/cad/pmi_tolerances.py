@@ -173,7 +173,8 @@ def dimension(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
                 f"{h.diameter_m * 1e3:g} mm entry bore"
             )
             continue
-        if abs(nominal_mm * MM_TO_M - h.diameter_m) > SAME_SIZE_M:
+        drawn_at_nominal = abs(nominal_mm * MM_TO_M - h.diameter_m) <= SAME_SIZE_M
+        if not drawn_at_nominal:
             pmi.notes.append(
                 f"{what} on {h.id}: the model's bore is {h.diameter_m * 1e3:g} mm; the limits "
                 f"{lower_mm:g}..{upper_mm:g} mm are kept about it"
@@ -184,8 +185,10 @@ def dimension(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
                 f"{what} on {h.id}: a second size ({held['size']['pmi_id']} kept)"
             )
             continue
+        # about the nominal as drawn, or about the model's diameter when it differs (to 1 pm)
+        base_mm = nominal_mm if drawn_at_nominal else h.diameter_m / MM_TO_M
         held["size"] = {
-            "upper_m": upper_mm * MM_TO_M - h.diameter_m,
-            "lower_m": lower_mm * MM_TO_M - h.diameter_m,
+            "upper_m": round((upper_mm - base_mm) * MM_TO_M, 12),
+            "lower_m": round((lower_mm - base_mm) * MM_TO_M, 12),
             "pmi_id": name,
         }
