@@ -80,7 +80,7 @@ def drawing(
     for hole, tol in tolerances.items():
         tol = dict(tol)
         pos = tol.get("position")
-        if pos is not None and pos["datums"] != frame:
+        if pos is not None and (not frame or pos["datums"] != frame):
             why = f"not the frame kept ({'|'.join(frame)})" if frame else "make no frame kept"
             left.append(f"{pos['pmi_id']} on {hole}: datums {'|'.join(pos['datums'])} {why}")
             del tol["position"]
