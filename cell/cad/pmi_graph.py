@@ -10,6 +10,7 @@ datum's letter::
 
     DATUM(..., 'B') <- SHAPE_ASPECT_RELATIONSHIP(..., #feature, #datum)
     #feature <- GEOMETRIC_ITEM_SPECIFIC_USAGE | ITEM_IDENTIFIED_REPRESENTATION_USAGE -> faces
+    #datum <- GEOMETRIC_ITEM_SPECIFIC_USAGE -> faces (NIST CTC-03 in AP242, edition 2)
     #feature -> SHAPE_ASPECT_RELATIONSHIP -> its member shape aspects -> their faces
 
 A feature that is a datum target (``PLACED_DATUM_TARGET_FEATURE``, ``DATUM_TARGET``) has no
@@ -127,12 +128,21 @@ class StepGraph:
         out = DatumFeatures()
         seen: set[int] = set()
         for datum in self.datums(letter):
+            self._usages(datum, out)  # some files attach the datum itself to its faces
             for rel in self.back.get(datum, []):
                 if "SHAPE_ASPECT_RELATIONSHIP" in self.types[rel]:
                     relating, related = self._refs(rel)[-2:]
                     if related == datum:
                         self._collect(relating, out, seen)
         return out
+
+    def _usages(self, aspect: int, out: DatumFeatures) -> None:
+        """The faces of the usages (GISU, IIRU) whose definition is ``aspect``."""
+        for user in self.back.get(aspect, []):
+            refs = self._refs(user)
+            if any(t.endswith("USAGE") for t in self.types[user]) and refs and refs[0] == aspect:
+                faces = [r for r in refs[2:] if "ADVANCED_FACE" in self.types.get(r, ())]
+                out.faces.extend(f for f in faces if f not in out.faces)
 
     def _collect(self, aspect: int, out: DatumFeatures, seen: set[int]) -> None:
         if aspect in seen:
@@ -144,12 +154,13 @@ class StepGraph:
         for user in self.back.get(aspect, []):
             types = self.types[user]
             refs = self._refs(user)
-            if "SHAPE_ASPECT_RELATIONSHIP" in types and refs[-2] == aspect:
-                if "DATUM" not in self.types.get(refs[-1], ()):
-                    self._collect(refs[-1], out, seen)
-            elif any(t.endswith("USAGE") for t in types) and refs and refs[0] == aspect:
-                faces = [r for r in refs[2:] if "ADVANCED_FACE" in self.types.get(r, ())]
-                out.faces.extend(f for f in faces if f not in out.faces)
+            if (
+                "SHAPE_ASPECT_RELATIONSHIP" in types
+                and refs[-2] == aspect
+                and "DATUM" not in self.types.get(refs[-1], ())
+            ):
+                self._collect(refs[-1], out, seen)
+        self._usages(aspect, out)
 
 
 class FaceLocator:

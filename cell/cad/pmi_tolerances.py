@@ -124,7 +124,7 @@ def tolerance(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
             )
             continue
         held["position"] = {
-            "zone_diameter_m": value_mm * MM_TO_M,
+            "zone_diameter_m": round(value_mm * MM_TO_M, 12),  # to 1 pm: no inch residue
             "datums": refs,
             "material_condition": condition,
             "pmi_id": name,
