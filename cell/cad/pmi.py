@@ -72,11 +72,21 @@ def _datum_feature(
 
 
 class _Graph:
-    """The STEP entity graph, read only when a datum needs it."""
+    """The STEP entity graph, read only when the PMI needs it."""
 
     def __init__(self, doc: StepDocument, geo: PmiFaces, holes: list[CadHole]) -> None:
         self.doc, self.geo, self.holes = doc, geo, holes
+        self.graph: StepGraph | None = None
         self.locator: FaceLocator | None = None
+
+    def _read(self) -> StepGraph:
+        if self.graph is None:
+            self.graph = StepGraph(self.doc.path)
+        return self.graph
+
+    def capped(self) -> set[str]:
+        """The names of the tolerances with a maximum value (``MAX``) in the file."""
+        return self._read().capped
 
     def faces(self, letter: str) -> tuple[list[int], int, int]:
         """The face numbers of datum ``letter`` in the entity graph, its number of datum
@@ -85,14 +95,13 @@ class _Graph:
             return [], 0, 0
         if self.locator is None:
             walls = sorted({k for h in self.holes for k in h.faces})
-            graph = StepGraph(self.doc.path)
-            self.locator = FaceLocator(self.doc.reader, graph, self.geo.map, walls)
+            self.locator = FaceLocator(self.doc.reader, self._read(), self.geo.map, walls)
         found = self.locator.graph.features(letter)
         faces, missing = self.locator.locate(found.faces)
         return faces, found.targets, len(missing)
 
 
-def _datums(gdt, geo: PmiFaces, holes: list[CadHole], pmi: Pmi, doc: StepDocument) -> None:
+def _datums(gdt, geo: PmiFaces, holes: list[CadHole], pmi: Pmi, graph: _Graph) -> None:
     """Fill ``pmi.datums`` (module doc)."""
     faces_of: dict[str, list[int]] = {}
     targets: dict[str, int] = {}
@@ -101,7 +110,6 @@ def _datums(gdt, geo: PmiFaces, holes: list[CadHole], pmi: Pmi, doc: StepDocumen
         name = obj.GetName().ToCString()
         faces_of.setdefault(name, []).extend(geo.of(lab))
         targets[name] = targets.get(name, 0) + int(obj.IsDatumTarget())
-    graph = _Graph(doc, geo, holes)
     for name, faces in faces_of.items():
         if not faces:
             faces, n_targets, missing = graph.faces(name)
@@ -167,9 +175,11 @@ def read_pmi(doc: StepDocument, holes: list[CadHole]) -> Pmi:
     if not pmi.semantic:
         return pmi
     geo = PmiFaces(doc)
-    _datums(gdt, geo, holes, pmi, doc)
+    graph = _Graph(doc, geo, holes)
+    _datums(gdt, geo, holes, pmi, graph)
+    capped = graph.capped() if tol_labels else set()
     for lab in tol_labels:
-        tolerance(lab, geo, holes, pmi)
+        tolerance(lab, geo, holes, pmi, capped)
     for lab in dim_labels:
         dimension(lab, geo, holes, pmi)
     _sizes_for_conditions(pmi)

@@ -101,11 +101,17 @@ class StepGraph:
         self.types: dict[int, tuple[str, ...]] = {}
         self.text: dict[int, str] = {}
         self.back: dict[int, list[int]] = {}
+        #: names of the geometric tolerances with a maximum value (``|⌀.045 MAX|``), which
+        #: OpenCascade 8.0's XCAF leaves out (its GetMaxValueModifier is 0 for them)
+        self.capped: set[str] = set()
         for m in _STATEMENT.finditer(text, max(start, 0)):
             n, body = int(m[1]), m[2]
             self.order.append(n)
             types = _top_types(body)
             self.types[n] = types
+            if "GEOMETRIC_TOLERANCE_WITH_MAXIMUM_TOLERANCE" in types:
+                name = re.search(r"GEOMETRIC_TOLERANCE\s*\(\s*'((?:[^']|'')*)'", body)
+                self.capped.add(name[1] if name else "")
             if any(t in _LINKS or t == "DATUM" for t in types):
                 self.text[n] = body
                 if any(t in _LINKS for t in types):

@@ -2,8 +2,9 @@
 
 A position tolerance is kept on a hole (``tolerances.position``) when it is attached to the
 walls of the bore the cell measures (the entry bore), its zone is a diameter (⌀), it has no
-zone modifier (projected, free state, statistical...) and its datum references are single
-datums without modifiers; the datum letters in the order of the frame, the zone in metres and
+zone modifier (projected, free state, statistical...) nor maximum value (``|⌀.045 MAX|``, read
+from the file's text: XCAF drops it) and its datum references are single datums without
+modifiers; the datum letters in the order of the frame, the zone in metres and
 the material condition (M: MMC, L: LMC, none: RFS) as the file gives them. A second position
 tolerance on one hole (a composite or two stacked frames) is listed: the cell holds one.
 
@@ -83,8 +84,9 @@ def _zone_problem(obj) -> str:
     return f"zone modifiers {', '.join(named)} not modelled" if named else ""
 
 
-def tolerance(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
-    """One geometric tolerance: kept on its holes, or listed (module doc)."""
+def tolerance(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi, capped: set[str]) -> None:
+    """One geometric tolerance: kept on its holes, or listed (module doc). ``capped``: the
+    names of the file's tolerances with a maximum value (read from its text)."""
     obj = attr(lab, XCAFDoc_GeomTolerance).GetObject()
     name = semantic_name(obj) or "geometric tolerance"
     value_mm = obj.GetValue()
@@ -103,6 +105,8 @@ def tolerance(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
         return
     holes_on = ", ".join(h.id for h in on)
     why = _zone_problem(obj) or "; ".join(ref_problems)
+    if not why and (obj.GetMaxValueModifier() > 0 or name in capped):
+        why = "a maximum tolerance (MAX) not modelled"
     if why:
         pmi.unmodelled.append(f"{what} on {holes_on} ({why})")
         return
