@@ -126,3 +126,24 @@ def test_ctc01_part_yaml_carries_the_tolerances(tmp_path: Path) -> None:
     from cell.config.schema import Hole
 
     assert all(Hole.model_validate(h).tolerances is not None for h in toleranced)
+
+
+def test_a_maximum_tolerance_is_read_from_the_text(tmp_path: Path) -> None:
+    """XCAF drops a position's maximum value (``|⌀.045 MAX|``): the entity graph names the
+    tolerances that have one (the entity as NIST FTC-07 in AP242 writes GP6)."""
+    from cell.cad.pmi_graph import StepGraph
+
+    step = tmp_path / "max.stp"
+    step.write_text(
+        "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n"
+        "#16533= ( GEOMETRIC_TOLERANCE('GP6','',#16532,#15545) "
+        "GEOMETRIC_TOLERANCE_WITH_DATUM_REFERENCE((#16290)) "
+        "GEOMETRIC_TOLERANCE_WITH_MAXIMUM_TOLERANCE(#16531) "
+        "GEOMETRIC_TOLERANCE_WITH_MODIFIERS((.MAXIMUM_MATERIAL_REQUIREMENT.)) "
+        "POSITION_TOLERANCE() );\n"
+        "#16534= ( GEOMETRIC_TOLERANCE('GP7','',#16532,#15545) "
+        "GEOMETRIC_TOLERANCE_WITH_DATUM_REFERENCE((#16290)) POSITION_TOLERANCE() );\n"
+        "ENDSEC;\nEND-ISO-10303-21;\n",
+        encoding="latin-1",
+    )
+    assert StepGraph(step).capped == {"GP6"}
