@@ -1,10 +1,11 @@
 """The faces of a datum feature that OpenCascade's XCAF document leaves without any, found in
 the STEP file's own entity graph.
 
-OpenCascade 7.8 reads a datum feature's faces from a ``GEOMETRIC_ITEM_SPECIFIC_USAGE`` only;
-several CAD systems (NIST CTC-01 and CTC-03 in AP242) write them as an
-``ITEM_IDENTIFIED_REPRESENTATION_USAGE(..., #feature, #rep, SET_REPRESENTATION_ITEM((#f1,
-#f2)))``, whose set of items OpenCascade's parser leaves empty. This module reads that much of
+OpenCascade 8.0 (cadquery-ocp 8.0.1) reads a datum feature's faces from a
+``GEOMETRIC_ITEM_SPECIFIC_USAGE`` on the feature only; some exporters (NIST CTC-01 and CTC-03
+in AP242) write them as an ``ITEM_IDENTIFIED_REPRESENTATION_USAGE(..., #feature, #rep,
+SET_REPRESENTATION_ITEM((#f1, #f2)))``, whose set of items OpenCascade's parser leaves empty,
+or put the usage on the ``DATUM`` itself. This module reads that much of
 the Part 21 text by hand (entity ids, types and references; no geometry) and follows, for a
 datum's letter::
 
@@ -17,7 +18,10 @@ A feature that is a datum target (``PLACED_DATUM_TARGET_FEATURE``, ``DATUM_TARGE
 faces here: it is counted as a target. The faces found (``ADVANCED_FACE`` entities) are turned
 into the shape's faces with OpenCascade's own transfer record
 (``XSControl_TransferReader.EntityFromShapeResult``): the reader numbers the model's entities in
-the order of the file, which :class:`StepGraph` checks entity by entity (type names).
+the order of the file, which :class:`FaceLocator` checks for each face (its type).
+
+The same reading gives the names of the tolerances with a maximum value (``StepGraph.capped``),
+which XCAF drops.
 """
 
 from __future__ import annotations
