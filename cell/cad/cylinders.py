@@ -30,8 +30,12 @@ class AxialFace:
     ``origin`` a point of the axis and ``direction`` its unit vector, the sign made canonical
     (largest component positive) so coaxial faces share it; ``t_range`` the interval of the
     axis the face covers, measured along ``direction`` from ``origin``; ``u_range`` its
-    angular extent (rad); ``radius`` the cylinder's radius (a cone's radii at both ends in
-    ``radii``); ``internal`` True when the material is outside the radius (a hole).
+    angular extent (rad) about ``direction``, from a reference that depends on ``direction``
+    only (:func:`_reference`), so that faces of one axis compare whatever their own surfaces'
+    x directions and handedness (some exporters write a hole's two halves as u 0..pi each, on
+    x directions half a turn apart: NIST CTC-03, FTC-07, FTC-09 in AP242); ``radius`` the
+    cylinder's radius (a cone's radii at both ends in ``radii``); ``internal`` True when the
+    material is outside the radius (a hole).
     """
 
     index: int
@@ -60,6 +64,29 @@ def canonical(direction: np.ndarray) -> float:
     """+1 or -1: the sign that makes ``direction``'s largest component positive."""
     k = int(np.argmax(np.abs(direction)))
     return 1.0 if direction[k] > 0 else -1.0
+
+
+def _reference(direction: np.ndarray) -> np.ndarray:
+    """A unit vector square to ``direction`` that depends on it alone: the world axis least
+    along it (the first of near ties), made square."""
+    k = int(np.flatnonzero(np.abs(direction) <= np.abs(direction).min() + 1e-3)[0])
+    e = np.zeros(3)
+    e[k] = 1.0
+    r = e - np.dot(e, direction) * direction
+    return r / np.linalg.norm(r)
+
+
+def _angles(ax3, direction: np.ndarray, umin: float, umax: float) -> tuple[float, float]:
+    """A face's u interval as angles about ``direction`` from :func:`_reference` (rad)."""
+    ref = _reference(direction)
+    x = _vec(ax3.XDirection())
+    offset = math.atan2(float(np.dot(np.cross(ref, x), direction)), float(np.dot(ref, x)))
+    # u turns counterclockwise about the surface's own axis on a right-handed frame
+    sense = float(np.sign(np.dot(_vec(ax3.Direction()), direction)))
+    if not ax3.Direct():
+        sense = -sense
+    a, b = offset + sense * umin, offset + sense * umax
+    return (min(a, b), max(a, b))
 
 
 def _axial(index: int, face, kind: str) -> AxialFace | None:
@@ -98,7 +125,7 @@ def _axial(index: int, face, kind: str) -> AxialFace | None:
         radius=r_ref,
         radii=(min(radii), max(radii)),
         t_range=(t[0], t[1]),
-        u_range=(umin, umax),
+        u_range=_angles(ax3, sign * z, umin, umax),
         internal=outward < 0,
     )
 

@@ -3,139 +3,58 @@ datums, position tolerances and diameter size tolerances, matched to the holes f
 faces they are attached to, as the cell file writes them (:mod:`cell.config.datums`).
 
 Kept, with the PMI's name as ``pmi_id``:
-- a datum on a hole's wall: ``hole: ID``; on several holes' walls: ``pattern: [IDs]``; on a
-  plane: ``plane: {holes: [...]}`` through the holes whose entry centres lie on it (>= 3);
+- a datum on a hole's measured bore: ``hole: ID``; on several holes' bores: ``pattern: [IDs]``;
+  on a plane: ``plane: {holes: [...]}`` through the holes whose entry centres lie on it (>= 3);
 - a position tolerance on a hole: ``position: {zone_diameter_m, datums, material_condition}``
-  (zone and datums as the PMI gives them; a modifier M/L becomes MMC/LMC);
-- a diameter dimension with limits on the measured bore: ``size: {upper_m, lower_m}``.
+  and a diameter dimension with limits: ``size: {upper_m, lower_m}``
+  (:mod:`cell.cad.pmi_tolerances`); a position at MMC or LMC only with the hole's size.
 
-Everything else (form, orientation, profile, runout tolerances; linear and angular
-dimensions; tolerances on faces that are no hole) is listed in
-``unmodelled``, one line each, never dropped silently. OpenCascade gives a plus/minus
-dimension's lower deviation as a magnitude; it is taken as below the nominal.
+Where XCAF attaches a datum to no face, its faces are read from the STEP entity graph
+(:mod:`cell.cad.pmi_graph`; said in ``notes``). Everything else (datum targets; form,
+orientation, profile, runout tolerances; linear and angular dimensions; tolerances on faces
+that are no hole or another bore than the measured one) is listed in ``unmodelled``, one line
+each, never dropped silently.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from OCP.BRepAdaptor import BRepAdaptor_Surface
-from OCP.GeomAbs import GeomAbs_Plane
-from OCP.OCP.collections import Sequence_TDF_Label
-from OCP.TDF import TDF_AttributeIterator, TDF_Label
-from OCP.TopAbs import TopAbs_FACE
-from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS
+from OCP.TDF import TDF_Label
 from OCP.XCAFDimTolObjects import (
     XCAFDimTolObjects_DimensionType_CommonLabel as COMMON_LABEL,
 )
 from OCP.XCAFDimTolObjects import (
     XCAFDimTolObjects_DimensionType_DimensionPresentation as PRESENTATION,
 )
-from OCP.XCAFDimTolObjects import (
-    XCAFDimTolObjects_DimensionType_Size_Diameter as SIZE_DIAMETER,
-)
-from OCP.XCAFDimTolObjects import (
-    XCAFDimTolObjects_GeomToleranceMatReqModif_L as MOD_L,
-)
-from OCP.XCAFDimTolObjects import (
-    XCAFDimTolObjects_GeomToleranceMatReqModif_M as MOD_M,
-)
-from OCP.XCAFDimTolObjects import (
-    XCAFDimTolObjects_GeomToleranceType_Position as POSITION,
-)
-from OCP.XCAFDoc import (
-    XCAFDoc_Datum,
-    XCAFDoc_Dimension,
-    XCAFDoc_DimTolTool,
-    XCAFDoc_DocumentTool,
-    XCAFDoc_GeomTolerance,
-)
+from OCP.XCAFDoc import XCAFDoc_Datum, XCAFDoc_Dimension, XCAFDoc_DocumentTool
 
-from cell.cad.cylinders import face_map
 from cell.cad.holes import CadHole
-from cell.cad.step_read import MM_TO_M, StepDocument
+from cell.cad.pmi_doc import Pmi, PmiFaces, attr, holes_of, labels
+from cell.cad.pmi_graph import FaceLocator, StepGraph
+from cell.cad.pmi_tolerances import SAME_SIZE_M, dimension, tolerance
+from cell.cad.step_read import StepDocument
 
-#: a hole's entry lies on a datum plane within this (m); a dimension names a bore within this
+__all__ = ["Pmi", "read_pmi"]
+
+#: a hole's entry lies on a datum plane within this (m)
 ON_PLANE_M = 1e-6
-SAME_SIZE_M = 1e-6
-
-
-@dataclass
-class Pmi:
-    """The PMI found: ``semantic`` False when the file has none; ``datums`` and per-hole
-    ``tolerances`` as cell-file mappings; ``unmodelled`` one line per PMI left out."""
-
-    semantic: bool = False
-    datums: list[dict[str, Any]] = field(default_factory=list)
-    tolerances: dict[str, dict[str, Any]] = field(default_factory=dict)
-    unmodelled: list[str] = field(default_factory=list)
-    counts: dict[str, int] = field(default_factory=dict)
-
-
-def _attr(label: TDF_Label, cls: type) -> Any:
-    it = TDF_AttributeIterator(label)
-    while it.More():
-        if isinstance(it.Value(), cls):
-            return it.Value()
-        it.Next()
-    return None
-
-
-def _labels(getter) -> list[TDF_Label]:
-    seq = Sequence_TDF_Label()
-    getter(seq)
-    return [seq.Value(i + 1) for i in range(seq.Length())]
-
-
-def _name(obj) -> str:
-    n = obj.GetSemanticName()
-    return "" if n is None else n.ToCString()
-
-
-class _Faces:
-    """The faces a PMI label is attached to, as face-map numbers."""
-
-    def __init__(self, doc: StepDocument) -> None:
-        self.shapes = XCAFDoc_DocumentTool.ShapeTool_s(doc.doc.Main())
-        self.map = face_map(doc.shape)
-
-    def of(self, label: TDF_Label) -> list[int]:
-        first, second = Sequence_TDF_Label(), Sequence_TDF_Label()
-        XCAFDoc_DimTolTool.GetRefShapeLabel_s(label, first, second)
-        out: list[int] = []
-        for i in range(first.Length()):
-            shape = self.shapes.GetShape_s(first.Value(i + 1))
-            ex = TopExp_Explorer(shape, TopAbs_FACE)
-            while ex.More():
-                k = self.map.FindIndex(ex.Current())
-                if k > 0:
-                    out.append(k)
-                ex.Next()
-        return out
-
-    def plane(self, index: int) -> tuple[np.ndarray, np.ndarray] | None:
-        """A planar face's point (m) and unit normal, None for another surface."""
-        surf = BRepAdaptor_Surface(TopoDS.Face(self.map.FindKey(index)))
-        if surf.GetType() != GeomAbs_Plane:
-            return None
-        pos = surf.Plane().Position()
-        p, n = pos.Location(), pos.Direction()
-        return np.array([p.X(), p.Y(), p.Z()]) * MM_TO_M, np.array([n.X(), n.Y(), n.Z()])
-
-
-def _holes_of(faces: list[int], holes: list[CadHole]) -> list[CadHole]:
-    return [h for h in holes if h.faces & set(faces)]
 
 
 def _datum_feature(
-    label: str, faces: list[int], geo: _Faces, holes: list[CadHole]
+    label: str, faces: list[int], geo: PmiFaces, holes: list[CadHole]
 ) -> tuple[dict[str, Any] | None, str]:
     """The cell-file datum for faces, or None and why not."""
-    on = _holes_of(faces, holes)
-    if on and len(on) == 1:
+    on = holes_of(faces, holes)
+    other = [
+        f"{h.id} (its {b * 1e3:g} mm bore; the {h.diameter_m * 1e3:g} mm entry bore is measured)"
+        for h in on
+        if (b := geo.bore_of(h, faces)) is not None and abs(b - h.diameter_m) > SAME_SIZE_M
+    ]
+    if other:
+        return None, f"on another bore than the measured one: {', '.join(other)}"
+    if len(on) == 1:
         return {"label": label, "hole": on[0].id}, ""
     if on:
         return {"label": label, "pattern": [h.id for h in on]}, ""
@@ -145,35 +64,102 @@ def _datum_feature(
         rims = [h.id for h in holes if abs(float(np.dot(np.array(h.entry_m) - p, n))) <= ON_PLANE_M]
         if len(rims) >= 3:
             return {"label": label, "plane": {"holes": rims}}, ""
-        return None, f"a plane with {len(rims)} hole rims on it (the cell's plane datum needs 3)"
+        return None, (
+            f"a plane with {len(rims)} hole entries on it (the cell's plane datum is the plane "
+            "through >= 3 measured entry rims)"
+        )
     return None, "not on a hole or a plane" if faces else "attached to no face"
 
 
-def _datums(gdt, geo: _Faces, holes: list[CadHole], pmi: Pmi) -> set[str]:
-    """Fill ``pmi.datums``; the labels kept."""
+class _Graph:
+    """The STEP entity graph, read only when the PMI needs it."""
+
+    def __init__(self, doc: StepDocument, geo: PmiFaces, holes: list[CadHole]) -> None:
+        self.doc, self.geo, self.holes = doc, geo, holes
+        self.graph: StepGraph | None = None
+        self.locator: FaceLocator | None = None
+
+    def _read(self) -> StepGraph:
+        if self.graph is None:
+            self.graph = StepGraph(self.doc.path)
+        return self.graph
+
+    def capped(self) -> set[str]:
+        """The names of the tolerances with a maximum value (``MAX``) in the file."""
+        return self._read().capped
+
+    def faces(self, letter: str) -> tuple[list[int], int, int]:
+        """The face numbers of datum ``letter`` in the entity graph, its number of datum
+        targets, and the number of its face entities not found in the shape."""
+        if self.doc.reader is None:
+            return [], 0, 0
+        if self.locator is None:
+            walls = sorted({k for h in self.holes for k in h.faces})
+            self.locator = FaceLocator(self.doc.reader, self._read(), self.geo.map, walls)
+        found = self.locator.graph.features(letter)
+        faces, missing = self.locator.locate(found.faces)
+        return faces, found.targets, len(missing)
+
+
+def _datums(gdt, geo: PmiFaces, holes: list[CadHole], pmi: Pmi, graph: _Graph) -> None:
+    """Fill ``pmi.datums`` (module doc)."""
     faces_of: dict[str, list[int]] = {}
-    for lab in _labels(gdt.GetDatumLabels):
-        obj = _attr(lab, XCAFDoc_Datum).GetObject()
+    targets: dict[str, int] = {}
+    for lab in labels(gdt.GetDatumLabels):
+        obj = attr(lab, XCAFDoc_Datum).GetObject()
         name = obj.GetName().ToCString()
         faces_of.setdefault(name, []).extend(geo.of(lab))
-    kept: list[dict[str, Any]] = []
+        targets[name] = targets.get(name, 0) + int(obj.IsDatumTarget())
     for name, faces in faces_of.items():
+        if not faces:
+            faces, n_targets, missing = graph.faces(name)
+            targets[name] = max(targets[name], n_targets)
+            if faces:
+                pmi.notes.append(
+                    f"datum {name}: {len(faces)} faces read from the STEP entity graph "
+                    "(OpenCascade's XCAF attaches it to none)"
+                    + (f"; {missing} face entities not found in the shape" if missing else "")
+                )
+        if not faces and targets[name]:
+            pmi.unmodelled.append(
+                f"datum {name}: {targets[name]} datum targets (points, lines or areas; the "
+                "cell's datums are holes, hole patterns and planes through hole rims)"
+            )
+            continue
         datum, why = _datum_feature(name, sorted(set(faces)), geo, holes)
         if datum is None:
             pmi.unmodelled.append(f"datum {name}: {why}")
         else:
-            kept.append({**datum, "pmi_id": f"datum {name}"})
-    pmi.datums = kept
-    return {d["label"] for d in kept}
+            pmi.datums.append({**datum, "pmi_id": f"datum {name}"})
+
+
+def _graphical(label: TDF_Label) -> bool:
+    """Whether a dimension label is presentation only (a drawn annotation without values)."""
+    kind = attr(label, XCAFDoc_Dimension).GetObject().GetType()
+    return kind in (PRESENTATION, COMMON_LABEL)
+
+
+def _sizes_for_conditions(pmi: Pmi) -> None:
+    """A position at MMC or LMC needs the hole's size limits: without them it is listed."""
+    for hid, tol in list(pmi.tolerances.items()):
+        pos = tol.get("position")
+        if pos is not None and pos["material_condition"] != "RFS" and "size" not in tol:
+            pmi.unmodelled.append(
+                f"{pos['pmi_id']} on {hid}: at {pos['material_condition']}, but the hole has no "
+                "size tolerance to give its bonus"
+            )
+            del tol["position"]
+        if not tol:
+            del pmi.tolerances[hid]
 
 
 def read_pmi(doc: StepDocument, holes: list[CadHole]) -> Pmi:
     """The PMI of ``doc`` matched to ``holes`` (module doc)."""
     gdt = XCAFDoc_DocumentTool.DimTolTool_s(doc.doc.Main())
-    tol_labels = _labels(gdt.GetGeomToleranceLabels)
-    all_dims = _labels(gdt.GetDimensionLabels)
+    tol_labels = labels(gdt.GetGeomToleranceLabels)
+    all_dims = labels(gdt.GetDimensionLabels)
     dim_labels = [d for d in all_dims if not _graphical(d)]
-    datum_labels = _labels(gdt.GetDatumLabels)
+    datum_labels = labels(gdt.GetDatumLabels)
     pmi = Pmi(semantic=bool(tol_labels or dim_labels or datum_labels))
     pmi.counts = {
         "geometric tolerances": len(tol_labels),
@@ -188,87 +174,13 @@ def read_pmi(doc: StepDocument, holes: list[CadHole]) -> Pmi:
         )
     if not pmi.semantic:
         return pmi
-    geo = _Faces(doc)
-    datums = _datums(gdt, geo, holes, pmi)
+    geo = PmiFaces(doc)
+    graph = _Graph(doc, geo, holes)
+    _datums(gdt, geo, holes, pmi, graph)
+    capped = graph.capped() if tol_labels else set()
     for lab in tol_labels:
-        _tolerance(gdt, lab, geo, holes, datums, pmi)
+        tolerance(lab, geo, holes, pmi, capped)
     for lab in dim_labels:
-        _dimension(lab, geo, holes, pmi)
+        dimension(lab, geo, holes, pmi)
+    _sizes_for_conditions(pmi)
     return pmi
-
-
-def _graphical(label: TDF_Label) -> bool:
-    """Whether a dimension label is presentation only (a drawn annotation without values)."""
-    kind = _attr(label, XCAFDoc_Dimension).GetObject().GetType()
-    return kind in (PRESENTATION, COMMON_LABEL)
-
-
-def _tolerance(gdt, lab, geo: _Faces, holes, datums: set[str], pmi: Pmi) -> None:
-    obj = _attr(lab, XCAFDoc_GeomTolerance).GetObject()
-    name = _name(obj) or "geometric tolerance"
-    kind = str(obj.GetType()).rsplit("_", 1)[-1]
-    value_mm = obj.GetValue()
-    refs = []
-    seq = Sequence_TDF_Label()
-    XCAFDoc_DimTolTool.GetDatumWithObjectOfTolerLabels_s(lab, seq)
-    for i in range(seq.Length()):
-        d = _attr(seq.Value(i + 1), XCAFDoc_Datum).GetObject()
-        refs.append((d.GetPosition(), d.GetName().ToCString()))
-    labels = [n for _, n in sorted(refs)]
-    on = _holes_of(geo.of(lab), holes)
-    what = f"{name}: {kind} {value_mm:g} mm" + (f" |{'|'.join(labels)}" if labels else "")
-    if obj.GetType() != POSITION:
-        pmi.unmodelled.append(f"{what} (not modelled: the cell evaluates position and size)")
-        return
-    if not on:
-        pmi.unmodelled.append(f"{what} (on no hole found)")
-        return
-    missing = [d for d in labels if d not in datums]
-    if missing:
-        holes_on = ", ".join(h.id for h in on)
-        pmi.unmodelled.append(f"{what} on {holes_on} (datums {missing} not modelled)")
-        return
-    mod = obj.GetMaterialRequirementModifier()
-    condition = "MMC" if mod == MOD_M else "LMC" if mod == MOD_L else "RFS"
-    for h in on:
-        pmi.tolerances.setdefault(h.id, {})["position"] = {
-            "zone_diameter_m": value_mm * MM_TO_M,
-            "datums": labels,
-            "material_condition": condition,
-            "pmi_id": name,
-        }
-
-
-def _dimension(lab, geo: _Faces, holes, pmi: Pmi) -> None:
-    obj = _attr(lab, XCAFDoc_Dimension).GetObject()
-    name = _name(obj) or "dimension"
-    kind = str(obj.GetType()).split("DimensionType_", 1)[-1]
-    on = _holes_of(geo.of(lab), holes)
-    if obj.GetType() != SIZE_DIAMETER:
-        pmi.unmodelled.append(f"{name}: {kind} {obj.GetValue():g} (not modelled)")
-        return
-    nominal_m = obj.GetValue() * MM_TO_M
-    if obj.IsDimWithRange():
-        upper = obj.GetUpperBound() * MM_TO_M - nominal_m
-        lower = obj.GetLowerBound() * MM_TO_M - nominal_m
-    elif obj.IsDimWithPlusMinusTolerance():
-        upper = obj.GetUpperTolValue() * MM_TO_M
-        lower = -abs(obj.GetLowerTolValue()) * MM_TO_M
-    else:
-        pmi.unmodelled.append(f"{name}: diameter {obj.GetValue():g} mm without limits")
-        return
-    what = f"{name}: diameter {obj.GetValue():g} mm {upper * 1e3:+g}/{lower * 1e3:+g}"
-    if not on:
-        pmi.unmodelled.append(f"{what} (on no hole found)")
-        return
-    for h in on:
-        if abs(h.diameter_m - nominal_m) > SAME_SIZE_M:
-            pmi.unmodelled.append(
-                f"{what} on {h.id}: another bore than the measured one ({h.diameter_m * 1e3:g} mm)"
-            )
-            continue
-        pmi.tolerances.setdefault(h.id, {})["size"] = {
-            "upper_m": upper,
-            "lower_m": lower,
-            "pmi_id": name,
-        }

@@ -38,12 +38,14 @@ _ENT_ID = re.compile(r"Ent\.Id\.(#\d+)")
 
 @dataclass
 class StepDocument:
-    """A STEP file read: the whole shape (mm), its XCAF document (the PMI) and the schema."""
+    """A STEP file read: the whole shape (mm), its XCAF document (the PMI), the schema and the
+    reader (its model and transfer record: the STEP entities behind the faces)."""
 
     path: Path
     shape: TopoDS_Shape
     doc: TDocStd_Document
     schema: str
+    reader: STEPCAFControl_Reader | None = None
 
 
 @contextlib.contextmanager
@@ -128,7 +130,7 @@ def read_step(path: str | Path) -> StepDocument:
     shape = _free_shape(doc)
     if not ok or shape is None or not TopExp_Explorer(shape, TopAbs_FACE).More():
         raise CadError(p, "file", "parses, but holds no solid or face (no geometry to import)")
-    return StepDocument(p, shape, doc, _schema(p))
+    return StepDocument(p, shape, doc, _schema(p), reader)
 
 
 def _free_shape(doc: TDocStd_Document) -> TopoDS_Shape | None:

@@ -87,13 +87,17 @@ def run_import_step(args: argparse.Namespace) -> int:
         for line in pmi.unmodelled:
             print(f"    - {line}")
     else:
-        n_tol = sum(len(v) for v in tolerances.values())
+        n_pos = sum(1 for v in tolerances.values() if "position" in v)
+        n_size = sum(1 for v in tolerances.values() if "size" in v)
+        frame = "|".join(d["label"] for d in datums) or "none"
         print(
-            f"  PMI: {len(datums)} datums, {n_tol} hole tolerances kept; "
+            f"  PMI: datum frame {frame}, {n_pos} position and {n_size} size tolerances kept; "
             f"{len(pmi.unmodelled) + len(left)} not modelled:"
         )
         for line in [*pmi.unmodelled, *left]:
             print(f"    - {line}")
+        for line in pmi.notes:
+            print(f"  note: {line}")
     if args.yaml:
         Path(args.yaml).write_text(_part_yaml(rows, datums), encoding="utf-8")
         print(f"  part section -> {args.yaml}")

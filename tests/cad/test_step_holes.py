@@ -170,3 +170,32 @@ def test_the_mesh_is_within_its_deflection(tmp_path: Path, deflection_m: float) 
     assert tm.is_watertight
     exact_volume_m3, area_m2 = part.volume * 1e-9, part.area * 1e-6
     assert abs(tm.volume - exact_volume_m3) <= deflection_m * area_m2
+
+
+@pytest.mark.parametrize("direct", [True, False])
+def test_two_half_walls_on_opposite_x_directions_are_one_bore(direct: bool) -> None:
+    """A hole wall written as two faces u 0..pi each, on cylinders whose x directions are half
+    a turn apart (as NIST CTC-03, FTC-07 and FTC-09 in AP242 have them), goes all the way
+    round: one full bore (each face's u is measured about the axis from one reference)."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.Geom import Geom_CylindricalSurface
+    from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
+    from OCP.TopoDS import TopoDS_Compound
+
+    from cell.cad.axes import chains
+    from cell.cad.cylinders import axial_faces, covered_angle, face_map
+
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for x in (1.0, -1.0):
+        ax3 = gp_Ax3(gp_Pnt(5, 7, 0), gp_Dir(0, 0, 1), gp_Dir(x, 0, 0))
+        if not direct:
+            ax3.YReverse()  # a left-handed frame: u turns the other way
+        face = BRepBuilderAPI_MakeFace(Geom_CylindricalSurface(ax3, 3.0), 0, math.pi, 0, 10, 1e-7)
+        builder.Add(compound, face.Face().Reversed() if direct else face.Face())
+    faces = axial_faces(face_map(compound))
+    assert len(faces) == 2 and all(f.internal for f in faces)
+    assert covered_angle([f.u_range for f in faces]) == pytest.approx(2 * math.pi)
+    found, partial = chains(faces)
+    assert len(found) == 1 and partial == [] and found[0].bores[0].full

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from cad_parts import write_part
+from p21_text import P21, on_axis
 
 from cell.cad.part import import_step
 from cell.cli import main
@@ -65,12 +66,40 @@ def test_ctc01_size_tolerances_as_the_file_states_them(ctc01) -> None:
 def test_ctc01_what_is_not_modelled_is_listed(ctc01) -> None:
     listed = "\n".join(ctc01.pmi.unmodelled)
     for name in ("Flatness.1", "Perpendicularity.1", "Position surfacic profile.2",
-                 "Position.1", "Position.2", "datum B", "datum C"):  # fmt: skip
+                 "Position.1", "Position.2"):  # fmt: skip
         assert name in listed
-    datums, tolerances, left = drawing(ctc01.pmi.datums, ctc01.pmi.tolerances)
-    # datum A alone (a plane through hole rims) makes no frame: said, and not kept
-    assert datums == [] and any("datums A" in line for line in left)
-    assert len(tolerances) == 7
+    # the two position tolerances are on the slots' planar walls, no hole
+    assert "Position.1: Position 0.75 mm |A|B|C (on 2 faces, none a hole's wall)" in listed
+
+
+def test_ctc01_datums_come_through_as_a_frame(ctc01) -> None:
+    by_label = {d["label"]: d for d in ctc01.pmi.datums}
+    assert by_label["B"] == {"label": "B", "hole": "H01", "pmi_id": "datum B"}
+    assert by_label["C"] == {"label": "C", "hole": "H09", "pmi_id": "datum C"}
+    # A: the top face, through the entry rims of the 8 holes that open into it
+    assert len(by_label["A"]["plane"]["holes"]) == 8
+    # B and C: OpenCascade's XCAF attaches them to no face; the entity graph gives them
+    assert sum("entity graph" in n for n in ctc01.pmi.notes) == 2
+    datums, _, left = drawing(ctc01.pmi.datums, ctc01.pmi.tolerances)
+    assert [d["label"] for d in datums] == ["A", "B", "C"] and left == []
+
+
+def test_ctc01_datum_holes_as_the_file_states_them(ctc01) -> None:
+    """The faces of datums B and C read a second time from the STEP text (their cylinders'
+    axes and radii): the holes kept lie on those axes, with those diameters."""
+    text = P21(NIST)
+    by_id = {h.id: h for h in ctc01.scan.holes}
+    by_label = {d["label"]: d for d in ctc01.pmi.datums}
+    for letter in ("B", "C"):
+        faces = text.datum_faces(letter)
+        assert len(faces) == 2  # two half cylinders
+        hole = by_id[by_label[letter]["hole"]]
+        for face in faces:
+            axis = text.cylinder(face)
+            assert axis is not None and on_axis(hole.entry_m, axis)
+            assert abs(2 * axis[2] * 1e-3 - hole.diameter_m) < 1e-9
+        others = [h for h in ctc01.scan.holes if h is not hole]
+        assert not any(on_axis(h.entry_m, text.cylinder(min(faces))) for h in others)
 
 
 def test_no_semantic_pmi_is_said(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -88,6 +117,11 @@ def test_ctc01_part_yaml_carries_the_tolerances(tmp_path: Path) -> None:
     part = yaml.safe_load(out.read_text())["part"]
     toleranced = [h for h in part["holes"] if "tolerances" in h]
     assert len(toleranced) == 7
+    assert [(d["label"], d["pmi_id"]) for d in part["datums"]] == [
+        ("A", "datum A"),
+        ("B", "datum B"),
+        ("C", "datum C"),
+    ]
     assert {h["tolerances"]["size"]["pmi_id"] for h in toleranced} == {"diameter"}
     from cell.config.schema import Hole
 
