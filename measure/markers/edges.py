@@ -47,8 +47,8 @@ def dot_edge_points(
 ) -> tuple[np.ndarray, float, float]:
     """Edge points (n, 2) of the dot (image pixels), and the median white and black levels.
 
-    ``img`` is float32 gray; rays whose white-black contrast is below ``min_contrast`` (gray
-    levels) give no point."""
+    ``img`` is the gray image (uint8, uint16 or float: the samples are float64 either way);
+    rays whose white-black contrast is below ``min_contrast`` (gray levels) give no point."""
     perim = np.pi * (cand.a + cand.b)
     n_rays = int(np.clip(perim / 1.5, 48, 720))
     t = np.linspace(0.0, 2 * np.pi, n_rays, endpoint=False)
