@@ -186,7 +186,7 @@ def detect_markers(
         The detections, ordered by code. A hole (a dark bore in a bright plate) is never a
         candidate; a dot whose code cannot be read, or whose code is read twice, is dropped.
     """
-    gray = to_gray(image, "marker")
+    gray = np.ascontiguousarray(to_gray(image, "marker"))
     Km = None if K is None else np.asarray(K, dtype=np.float64).reshape(3, 3)
     d = np.zeros(5) if dist is None else np.asarray(dist, dtype=np.float64).ravel()
     gray8 = to_8bit(gray)
