@@ -71,15 +71,16 @@ def test_views_from_worker_processes_equal_views_from_this_process(scenes, small
     geometry = _geometry(small_cell)
     results = {}
     snaps = [(vid, T, cam.snapshot()) for vid, T, cam in scenes]
-    for workers in (0, 2):
-        with _executor(workers) as pool:
+    pairs = [(vid, T, s()) for vid, T, s in snaps]  # a camera without snapshots sends pairs
+    for workers, sources in ((0, snaps), (2, snaps), ("2, pairs", pairs)):
+        with _executor(2 if workers else 0) as pool:
             jobs = [pool.submit(observe_view, s, stereo, codes, geometry, vid, T)
-                    for vid, T, s in snaps]  # fmt: skip
+                    for vid, T, s in sources]  # fmt: skip
             results[workers] = [job.result()[0] for job in jobs]
-    serial, parallel = results[0], results[2]
-    assert [v.view_id for v in parallel] == [v.view_id for v in serial]
+    serial = results[0]
     assert sum(len(v.both()) for v in serial) >= 8  # the views see markers
-    for a, b in zip(serial, parallel, strict=True):
+    for a, b in [ab for key in (2, "2, pairs") for ab in zip(serial, results[key], strict=True)]:
+        assert a.view_id == b.view_id
         for side in ("uv_left", "uv_right"):
             da, db = getattr(a, side), getattr(b, side)
             assert sorted(da) == sorted(db)

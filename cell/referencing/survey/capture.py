@@ -38,6 +38,9 @@ from measure import StereoCalibration
 
 log = logging.getLogger(__name__)
 
+#: captured pairs (5 MP each) that may wait for a worker before the arm waits for them
+PAIRS_WAITING_PER_WORKER = 2
+
 #: ``progress(event, data)``: "view" after each view (``k``, ``n``, ``id``, ``markers``)
 Progress = Callable[[str, dict], None]
 
@@ -121,7 +124,8 @@ class SurveyCapture(Motion):
         n = len(tour.stops)
         views: list[MarkerView] = []
         snapshot = getattr(self.camera, "snapshot", None)
-        with _executor(self.options.workers) as pool:
+        pool = _executor(self.options.workers)
+        try:
             pending: deque[Future] = deque()
             for k, stop in enumerate(tour.stops):
                 t = time.perf_counter()
@@ -137,6 +141,11 @@ class SurveyCapture(Motion):
                 del source
                 while pending and pending[0].done():  # in the tour's order
                     self._collect(views, pending.popleft(), n, wall)
+                # pairs (not snapshots) wait in memory: the arm waits when too many do
+                if snapshot is None and len(pending) > PAIRS_WAITING_PER_WORKER * max(
+                    self.options.workers, 1
+                ):
+                    self._collect(views, pending.popleft(), n, wall)
             t = time.perf_counter()
             self._move(n, "home after the survey")
             t_end = self._call("status", self.client.status).time_s
@@ -145,6 +154,8 @@ class SurveyCapture(Motion):
             while pending:
                 self._collect(views, pending.popleft(), n, wall)
             wall["wait_s"] += time.perf_counter() - t
+        finally:  # after a fault, the views not yet rendered or detected are dropped
+            pool.shutdown(wait=True, cancel_futures=True)
         return SurveyCaptures(views, float(t_start), float(t_end), wall)
 
     def _collect(self, views: list[MarkerView], job: Future, n: int, wall: dict) -> None:
