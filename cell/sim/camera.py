@@ -14,12 +14,18 @@ with markers and neither a hole nor the plate (a survey view) renders them with
 :func:`measure.synth.markers.render_markers_pair`. A hole scene's surface (a plane across the
 whole image) hides the markers more than 0.1 m behind it; otherwise the part does not hide a
 marker, and a view of the plate shows no marker.
+
+:meth:`SimCamera.snapshot` takes the exposure now and returns the rendering as a picklable
+function (the scene, the head and the seed), so that a survey renders its views in worker
+processes while the arm moves on; :meth:`SimCamera.capture` is the snapshot rendered at once.
 """
 
 from __future__ import annotations
 
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -101,9 +107,18 @@ class SimCamera:
     def capture(self) -> StereoPair:
         """Render the pair the head sees now (an exposure takes no simulation time)."""
         with self.world.clock.held():
-            return self._capture(self.world.clock.now())
+            return self._snapshot(self.world.clock.now())()
 
-    def _capture(self, t: float) -> StereoPair:
+    def snapshot(self) -> Callable[[], StereoPair]:
+        """The exposure now, rendered later: a picklable function that renders the pair the
+        head sees at this moment (what :meth:`capture` returns), so that the rendering can run
+        in another process while the arm moves on. The capture is counted and
+        :attr:`last_truth` set now; the same snapshots render the same pairs wherever and in
+        whatever order they are rendered."""
+        with self.world.clock.held():
+            return self._snapshot(self.world.clock.now())
+
+    def _snapshot(self, t: float) -> Callable[[], StereoPair]:
         T_cell_tcp = self.world.true_T_cell_tcp(self.controller.q_rad(), t)
         kind, feature = self._in_view(invert(T_cell_tcp @ self._T_head_left))
         s_target = self._target_distance(T_cell_tcp)
@@ -119,7 +134,7 @@ class SimCamera:
         T_left_cell = invert(T_cell_left)
         self.captures += 1
         if kind == "target":
-            return self._target_pair(T_cell_left, seed)
+            return self._target_scene(T_cell_left, seed)
         surface = None
         if feature is not None:
             surface = (T_left_cell[:3, :3] @ feature.position_m + T_left_cell[:3, 3],
@@ -132,21 +147,18 @@ class SimCamera:
         if feature is None:  # bare surface facing the head, no hole anywhere near the view
             self.last_truth = CaptureTruth(None, "none", T_cell_left, None, None)
             if markers:
-                pair = render_markers_pair(self.true_stereo, markers, self.render, seed)
-            else:
-                pair = render_hole_pair(self.true_stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
-            return StereoPair(pair.left, pair.right)
+                return partial(_render_markers, self.true_stereo, markers, self.render, seed)
+            return partial(_render_bare, self.true_stereo)
         c = T_left_cell[:3, :3] @ feature.position_m + T_left_cell[:3, 3]
         n = T_left_cell[:3, :3] @ feature.normal
         if kind == "missing":  # the surface is there, the hole is not: render it far off-view
             u = np.cross(n, [1.0, 0.0, 0.0])
             c = c + 5.0 * u / np.linalg.norm(u)
-        fn = render_reference_pair if kind == "reference" else render_hole_pair
-        pair = fn(self.true_stereo, c, n, feature.diameter_m, self.render, seed, markers=markers)
         self.last_truth = CaptureTruth(
             feature.id, kind, T_cell_left, feature.position_m.copy(), feature.diameter_m
         )
-        return StereoPair(pair.left, pair.right)
+        return partial(_render_hole, kind == "reference", self.true_stereo, c, n,
+                       feature.diameter_m, self.render, seed, markers)  # fmt: skip
 
     def _marker_patches(
         self, T_left_cell: np.ndarray, surface: tuple[np.ndarray, np.ndarray] | None = None
@@ -203,14 +215,13 @@ class SimCamera:
                 return float("inf")
         return None
 
-    def _target_pair(self, T_cell_left: np.ndarray, seed: int) -> StereoPair:
-        """Render the calibration plate at its true pose in the true head."""
+    def _target_scene(self, T_cell_left: np.ndarray, seed: int) -> Callable[[], StereoPair]:
+        """The calibration plate at its true pose in the true head, to render."""
         spec = self.world.cell.calibration_target.target_spec()
         T_left_target = invert(T_cell_left) @ self.world.T_cell_target
-        r = render_target_pair(self.true_stereo, spec, T_left_target, seed=seed)
         origin = self.world.T_cell_target[:3, 3].copy()
         self.last_truth = CaptureTruth("calibration_target", "target", T_cell_left, origin, None)
-        return StereoPair(r.left, r.right)
+        return partial(_render_target, self.true_stereo, spec, T_left_target, seed)
 
     def _in_view(self, T_left_cell: np.ndarray) -> tuple[str, TrueHole | None]:
         T_head_cell = invert(self._T_head_left) @ T_left_cell
@@ -255,6 +266,31 @@ def _in_either_image(stereo: StereoCalibration, p_left: np.ndarray, n_left: np.n
         inside |= ((uv[:, 0] > -0.05 * w) & (uv[:, 0] < 1.05 * w) & (uv[:, 1] > -0.05 * h)
                    & (uv[:, 1] < 1.05 * h) & (P[:, 2] > 0.05))  # fmt: skip
     return ok & inside
+
+
+def _render_markers(stereo: StereoCalibration, markers: list[MarkerPatch],
+                    render: RenderOptions, seed: int) -> StereoPair:  # fmt: skip
+    pair = render_markers_pair(stereo, markers, render, seed)
+    return StereoPair(pair.left, pair.right)
+
+
+def _render_bare(stereo: StereoCalibration) -> StereoPair:
+    pair = render_hole_pair(stereo, [5.0, 0.0, 0.25], [0.0, 0.0, -1.0], 0.01)
+    return StereoPair(pair.left, pair.right)
+
+
+def _render_hole(reference: bool, stereo: StereoCalibration, c: np.ndarray, n: np.ndarray,
+                 diameter_m: float, render: RenderOptions, seed: int,
+                 markers: list[MarkerPatch]) -> StereoPair:  # fmt: skip
+    fn = render_reference_pair if reference else render_hole_pair
+    pair = fn(stereo, c, n, diameter_m, render, seed, markers=markers)
+    return StereoPair(pair.left, pair.right)
+
+
+def _render_target(stereo: StereoCalibration, spec, T_left_target: np.ndarray,
+                   seed: int) -> StereoPair:  # fmt: skip
+    r = render_target_pair(stereo, spec, T_left_target, seed=seed)
+    return StereoPair(r.left, r.right)
 
 
 def _depth(T_cell_head: np.ndarray, feature: TrueHole) -> float:

@@ -113,7 +113,8 @@ def _measure(
     K: np.ndarray | None,
     dist: np.ndarray,
     design: MarkerDesign,
-) -> MarkerDetection | None:
+) -> tuple[MarkerDetection, EllipseFit] | None:
+    """The candidate's detection and its dot's ellipse in image pixels, or None."""
     if not _dark_surround_candidate(img, cand):
         return None
     pts, white, black = dot_edge_points(img, cand, MIN_CONTRAST * full)
@@ -138,7 +139,7 @@ def _measure(
         if ideal is None:
             return None
         fit, center = ideal
-    return MarkerDetection(
+    det = MarkerDetection(
         code=int(code),
         center_px=center,
         ellipse=fit.opencv(),
@@ -149,6 +150,20 @@ def _measure(
         contrast=float(white - black),
         confidence=float(conf),
     )
+    return det, raw
+
+
+def _in_label(center: np.ndarray, dots: list[EllipseFit], design: MarkerDesign) -> bool:
+    """Whether ``center`` lies on the label of an identified ring marker (within its label
+    radius, in units of its dot's ellipse): a white code sector there is not a dot."""
+    reach = 2.0 * design.label_radius  # the label's radius in dot radii
+    for dot in dots:
+        c, s = np.cos(dot.angle), np.sin(dot.angle)
+        dx, dy = center[0] - dot.center[0], center[1] - dot.center[1]
+        u, v = (c * dx + s * dy) / dot.a, (-s * dx + c * dy) / dot.b
+        if u * u + v * v < reach * reach:
+            return True
+    return False
 
 
 def detect_markers(
@@ -171,17 +186,22 @@ def detect_markers(
         The detections, ordered by code. A hole (a dark bore in a bright plate) is never a
         candidate; a dot whose code cannot be read, or whose code is read twice, is dropped.
     """
-    gray = to_gray(image, "marker")
+    gray = np.ascontiguousarray(to_gray(image, "marker"))
     Km = None if K is None else np.asarray(K, dtype=np.float64).reshape(3, 3)
     d = np.zeros(5) if dist is None else np.asarray(dist, dtype=np.float64).ravel()
     gray8 = to_8bit(gray)
-    img = gray.astype(np.float32)
     full = _full_scale(gray)
     wanted = None if codes is None else {int(c) for c in codes}
-    found = []
-    for cand in find_dot_candidates(gray8):
-        det = _measure(img, gray8, cand, full, Km, d, design)
-        if det is not None and (wanted is None or det.code in wanted):
+    found, dots = [], []
+    for cand in find_dot_candidates(gray8):  # largest first: a dot before its code's sectors
+        if design.kind == "ring" and _in_label(cand.center, dots, design):
+            continue
+        out = _measure(gray, gray8, cand, full, Km, d, design)
+        if out is None:
+            continue
+        det, raw = out
+        dots.append(raw)
+        if wanted is None or det.code in wanted:
             found.append(det)
     counts = Counter(m.code for m in found)
     return sorted((m for m in found if counts[m.code] == 1), key=lambda m: m.code)

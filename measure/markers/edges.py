@@ -33,12 +33,14 @@ def bilinear(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     h, w = img.shape
     x = np.clip(x, 0.0, w - 1.000001)
     y = np.clip(y, 0.0, h - 1.000001)
-    x0, y0 = np.floor(x).astype(np.intp), np.floor(y).astype(np.intp)
+    x0, y0 = np.floor(x), np.floor(y)
     fx, fy = x - x0, y - y0
-    i00 = img[y0, x0]
-    i01 = img[y0, x0 + 1]
-    i10 = img[y0 + 1, x0]
-    i11 = img[y0 + 1, x0 + 1]
+    flat = img.reshape(-1)
+    k = y0.astype(np.intp) * w + x0.astype(np.intp)  # the top-left neighbour, row-major
+    i00 = flat.take(k)
+    i01 = flat.take(k + 1)
+    i10 = flat.take(k + w)
+    i11 = flat.take(k + (w + 1))
     return (i00 * (1 - fx) + i01 * fx) * (1 - fy) + (i10 * (1 - fx) + i11 * fx) * fy
 
 
@@ -47,8 +49,8 @@ def dot_edge_points(
 ) -> tuple[np.ndarray, float, float]:
     """Edge points (n, 2) of the dot (image pixels), and the median white and black levels.
 
-    ``img`` is float32 gray; rays whose white-black contrast is below ``min_contrast`` (gray
-    levels) give no point."""
+    ``img`` is the gray image (uint8, uint16 or float: the samples are float64 either way);
+    rays whose white-black contrast is below ``min_contrast`` (gray levels) give no point."""
     perim = np.pi * (cand.a + cand.b)
     n_rays = int(np.clip(perim / 1.5, 48, 720))
     t = np.linspace(0.0, 2 * np.pi, n_rays, endpoint=False)

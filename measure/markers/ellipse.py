@@ -83,7 +83,8 @@ def conic_params(coef: np.ndarray) -> tuple[float, float, float, float, float] |
 
 
 def _sampson(p: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    cx, cy, a, b, th = p
+    """Sampson distances (n,) of ``pts`` from the ellipse ``p``; ``p`` (k, 5): (k, n)."""
+    cx, cy, a, b, th = (p[..., i, None] for i in range(5))
     c, s = np.cos(th), np.sin(th)
     dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
     xr, yr = c * dx + s * dy, -s * dx + c * dy
@@ -92,16 +93,18 @@ def _sampson(p: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return F / g
 
 
+_STEPS = np.array([1e-4, 1e-4, 1e-4, 1e-4, 1e-6])
+
+
 def _gauss_newton(p: np.ndarray, pts: np.ndarray, iters: int) -> tuple[np.ndarray, np.ndarray]:
-    steps = np.array([1e-4, 1e-4, 1e-4, 1e-4, 1e-6])
     JtJ = np.eye(5)
     for _ in range(iters):
-        r = _sampson(p, pts)
-        J = np.empty((len(pts), 5))
-        for k in range(5):
-            q = p.copy()
-            q[k] += steps[k]
-            J[:, k] = (_sampson(q, pts) - r) / steps[k]
+        # the distances at p and at p moved by each step, in one evaluation (6, n)
+        q = np.repeat(p[None], 6, axis=0)
+        q[1:] += np.diag(_STEPS)
+        rq = _sampson(q, pts)
+        r = rq[0]
+        J = np.ascontiguousarray(((rq[1:] - r) / _STEPS[:, None]).T)  # (n, 5), as BLAS had it
         JtJ = J.T @ J
         try:
             dp = -np.linalg.solve(JtJ, J.T @ r)

@@ -27,10 +27,14 @@ def ring_samples(img: np.ndarray, dot: EllipseFit, radii: np.ndarray, n: int) ->
     """Mean over ``radii`` (in dot radii) of the image at ``n`` marker angles ``2πj/n``
     (counter-clockwise seen from the front, from an arbitrary origin)."""
     t = -2.0 * np.pi * np.arange(n) / n  # the image of the front face is mirrored
+    radii = np.asarray(radii, dtype=float)
+    c, s = np.cos(dot.angle), np.sin(dot.angle)
+    x = (radii * dot.a)[:, None] * np.cos(t)  # every radius at once, as EllipseFit.point
+    y = (radii * dot.b)[:, None] * np.sin(t)
+    samples = bilinear(img, dot.center[0] + (c * x - s * y), dot.center[1] + (s * x + c * y))
     vals = np.zeros(n)
-    for rho in radii:
-        p = dot.point(t, rho)
-        vals += bilinear(img, p[:, 0], p[:, 1])
+    for row in samples:  # summed radius by radius
+        vals += row
     return vals / len(radii)
 
 

@@ -118,7 +118,7 @@ def _ray(gnx, gny, gx0, gy0, step, px, py) -> tuple[float, float, float, float, 
 
 
 @njit(cache=True)
-def marker_patch(grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels, lit, out):
+def marker_patch(grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels, lit, out, spans):
     """Draw one marker into ``out`` ((h, w) float32: the pixels ``box`` = (x0, y0) onward,
     holding what lies behind the marker).
 
@@ -126,13 +126,14 @@ def marker_patch(grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels
     step)``, interpolated bilinearly; ``H`` maps a ray to homogeneous marker coordinates (dot
     diameters); rays with ``H[2] . d <= 0`` miss the marker's face. ``geo``: ring ``(r_in,
     r_out, label_radius)``, tag ``(x_lo, x_hi, y_lo, y_hi, field_x0, field_top, cell)``.
-    ``levels`` = (black, white) reflectance; ``lit`` ((h, w)): illumination.
+    ``levels`` = (black, white) reflectance; ``lit`` ((h, w)): illumination. ``spans`` (h, 2):
+    per row the columns ``[lo, hi)`` that can touch the label (the rest are left as they are).
     """
-    h, w = out.shape
+    h = out.shape[0]
     gnx, gny = grid[0], grid[1]
     black, white_level = levels[0], levels[1]
     for yy in range(h):
-        for xx in range(w):
+        for xx in range(spans[yy, 0], spans[yy, 1]):
             x, y, rx_x, ry_x, rx_y, ry_y = _ray(
                 gnx, gny, gx0, gy0, step, float(box[0] + xx), float(box[1] + yy)
             )

@@ -4,28 +4,42 @@ identify the markers in both images (:func:`cell.referencing.detection.observe_p
 The arm moves with the run's machinery (:class:`cell.link.motion.Motion`: reload, reconnect
 within a budget, stop safely on a fault). Each view's prior is its planned left-camera pose
 (the arm's idea of it): it removes the perspective bias of the markers' centres and starts the
-adjustment. A view's detection runs while the arm moves on (OpenCV releases the GIL).
+adjustment.
+
+The views' detections run in ``workers`` processes while the arm moves on (the survey's images
+are many: on two cores, two at a time). A camera that can take a snapshot (the simulated head:
+``snapshot()`` returns a picklable function that renders the pair it saw) has its pairs
+rendered there too, so the arm never waits for a render. The views are collected in the tour's
+order, and a view's result depends only on its images: the same captures give the same views
+with any number of workers (``workers=0``: in this process, one view after another).
 """
 
 from __future__ import annotations
 
 import logging
+import multiprocessing
 import time
-from collections.abc import Callable
-from concurrent.futures import Future, ThreadPoolExecutor
+from collections import deque
+from collections.abc import Callable, Mapping
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 
-from cell.camera import CameraBackend
+import numpy as np
+
+from cell.camera import CameraBackend, StereoPair
 from cell.config import CellConfig
 from cell.config.markers import marker_codes, marker_in_cell
 from cell.link.client import ControllerClient
 from cell.link.motion import Motion
-from cell.referencing.detection import observe_pair
+from cell.referencing.detection import MarkerGeometry, observe_pair
 from cell.referencing.observations import MarkerView
 from cell.referencing.survey.tour import SurveyTour
 from measure import StereoCalibration
 
 log = logging.getLogger(__name__)
+
+#: captured pairs (5 MP each) that may wait for a worker before the arm waits for them
+PAIRS_WAITING_PER_WORKER = 2
 
 #: ``progress(event, data)``: "view" after each view (``k``, ``n``, ``id``, ``markers``)
 Progress = Callable[[str, dict], None]
@@ -33,17 +47,22 @@ Progress = Callable[[str, dict], None]
 
 @dataclass(frozen=True)
 class SurveyCaptureSettings:
-    """Wait after "in position" (s), longest move (s), how long a dead link is retried (s)."""
+    """Wait after "in position" (s), longest move (s), how long a dead link is retried (s),
+    the processes that render and detect (0: this process, one view after another)."""
 
     settle_s: float = 0.2
     move_timeout_s: float = 120.0
     reconnect_budget_s: float = 15.0
+    workers: int = 2
 
 
 @dataclass
 class SurveyCaptures:
     """Every view's markers, the controller clock at the start and the end (s) and the wall
-    time of each step (s)."""
+    time of each step (s): ``move_s``, ``capture_s`` (the trigger, and the render when it is
+    not deferred), ``wait_s`` (for the last detections after the tour); summed over the views
+    wherever they ran: ``render_s`` (deferred renders), ``detect_s`` and ``cpu_s`` (the render's
+    and the detection's CPU time)."""
 
     views: list[MarkerView]
     start_time_s: float
@@ -96,44 +115,95 @@ class SurveyCapture(Motion):
             self._safe_stop()
             raise
 
-    def _observe(self, vid: str, pair) -> tuple[MarkerView, float]:
-        t = time.perf_counter()
-        view = observe_pair(pair.left, pair.right, self.stereo, self.codes, self.geometry, vid,
-                            self.survey_tour.T_cell_left[vid])  # fmt: skip
-        return view, time.perf_counter() - t
-
     def _run(self) -> SurveyCaptures:
         tour = self.survey_tour.tour
-        wall = {"move_s": 0.0, "capture_s": 0.0, "detect_s": 0.0}
+        wall = {"move_s": 0.0, "capture_s": 0.0, "wait_s": 0.0, "render_s": 0.0,
+                "detect_s": 0.0, "cpu_s": 0.0}  # fmt: skip
         self._load(tour)
         t_start = self._call("status", self.client.status).time_s
         n = len(tour.stops)
         views: list[MarkerView] = []
-        with ThreadPoolExecutor(max_workers=1) as pool:
-            pending: list[Future] = []
+        snapshot = getattr(self.camera, "snapshot", None)
+        pool = _executor(self.options.workers)
+        try:
+            pending: deque[Future] = deque()
             for k, stop in enumerate(tour.stops):
                 t = time.perf_counter()
                 self._move(k, f"survey view {stop.hole_id}")
                 self._settled_status()
                 wall["move_s"] += time.perf_counter() - t
                 t = time.perf_counter()
-                pair = self.camera.capture()
+                source = snapshot() if snapshot is not None else self.camera.capture()
                 wall["capture_s"] += time.perf_counter() - t
-                if pending:
-                    self._collect(views, pending.pop(), n, wall)
-                pending.append(pool.submit(self._observe, stop.hole_id, pair))
-                del pair
+                pending.append(pool.submit(observe_view, source, self.stereo, self.codes,
+                                           self.geometry, stop.hole_id,
+                                           self.survey_tour.T_cell_left[stop.hole_id]))  # fmt: skip
+                del source
+                while pending and pending[0].done():  # in the tour's order
+                    self._collect(views, pending.popleft(), n, wall)
+                # pairs (not snapshots) wait in memory: the arm waits when too many do
+                if snapshot is None and len(pending) > PAIRS_WAITING_PER_WORKER * max(
+                    self.options.workers, 1
+                ):
+                    self._collect(views, pending.popleft(), n, wall)
             t = time.perf_counter()
             self._move(n, "home after the survey")
             t_end = self._call("status", self.client.status).time_s
             wall["move_s"] += time.perf_counter() - t
-            if pending:
-                self._collect(views, pending.pop(), n, wall)
+            t = time.perf_counter()
+            while pending:
+                self._collect(views, pending.popleft(), n, wall)
+            wall["wait_s"] += time.perf_counter() - t
+        finally:  # after a fault, the views not yet rendered or detected are dropped
+            pool.shutdown(wait=True, cancel_futures=True)
         return SurveyCaptures(views, float(t_start), float(t_end), wall)
 
     def _collect(self, views: list[MarkerView], job: Future, n: int, wall: dict) -> None:
-        view, dt = job.result()
-        wall["detect_s"] += dt
+        view, times = job.result()
+        for key, dt in times.items():
+            wall[key] += dt
         views.append(view)
         self.progress("view", {"k": len(views), "n": n, "id": view.view_id,
                                "markers": len(view.both())})  # fmt: skip
+
+
+class _InProcess(Executor):
+    """Runs each job at once, in this process (``workers=0``)."""
+
+    def submit(self, fn, /, *args, **kwargs) -> Future:  # type: ignore[override]
+        future: Future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as exc:  # handed to the caller by result()
+            future.set_exception(exc)
+        return future
+
+
+def _executor(workers: int) -> Executor:
+    """``workers`` processes started by a fork server (a process that runs a simulator holds
+    threads whose locks a forked child would inherit locked), or this process."""
+    if workers <= 0:
+        return _InProcess()
+    ctx = multiprocessing.get_context("forkserver")
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+
+
+def observe_view(
+    source: StereoPair | Callable[[], StereoPair],
+    stereo: StereoCalibration,
+    codes: Mapping[int, str],
+    geometry: MarkerGeometry,
+    view_id: str,
+    T_cell_left_prior: np.ndarray,
+) -> tuple[MarkerView, dict[str, float]]:
+    """One view's markers (:func:`observe_pair`) from its pair, or from a snapshot that renders
+    it (``source()``); and the wall time of the render and the detection and their CPU time (s)."""
+    t, c = time.perf_counter(), time.thread_time()
+    pair = source if isinstance(source, StereoPair) else source()
+    render_s = 0.0 if isinstance(source, StereoPair) else time.perf_counter() - t
+    t = time.perf_counter()
+    view = observe_pair(pair.left, pair.right, stereo, codes, geometry, view_id,
+                        T_cell_left_prior)  # fmt: skip
+    times = {"render_s": render_s, "detect_s": time.perf_counter() - t,
+             "cpu_s": time.thread_time() - c}  # fmt: skip
+    return view, times
