@@ -10,8 +10,9 @@ by :mod:`cell.sim.camserver`).
 
 from __future__ import annotations
 
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -38,3 +39,13 @@ class CameraBackend(Protocol):
     def close(self) -> None:
         """Release the cameras."""
         ...
+
+
+def computing(camera: Any) -> AbstractContextManager[Any]:
+    """The block in which the cell computer works on a pair while the arm waits at its stop.
+    A real head: nothing (the robot's time passes). The in-process simulated head
+    (:meth:`cell.sim.camera.SimCamera.computing`) holds the simulation's clock there, as a
+    computer that keeps up with its arm would: the simulated arm then warms by the same amount
+    whatever the load of the machine running the simulation, and a seed gives the same figures."""
+    hold = getattr(camera, "computing", None)
+    return hold() if callable(hold) else nullcontext()

@@ -21,6 +21,7 @@ import numpy as np
 
 from cell.calibration.use import RunCalibration, RunGeometry, calibrated_stereo, correct_tour
 from cell.camera import CameraBackend
+from cell.camera.backend import computing
 from cell.camera.errors import PairError
 from cell.config import CellConfig
 from cell.config.markers import marker_codes
@@ -309,6 +310,12 @@ class Runner(ReferencePhase):
         except PairError as exc:  # no pair of one trigger: this stop fails, the run goes on
             return self._uncaptured(k, stop.hole_id, exc, st, clock)
         clock.lap("capture_s")
+        with computing(self.camera):  # the arm waits at its stop while the computer works
+            return self._process_pair(k, stop, pair, st, clock)
+
+    def _process_pair(self, k: int, stop, pair, st, clock: _Laps
+                      ) -> tuple[HoleResult, dict[str, float]]:  # fmt: skip
+        """Locate, measure, compensate, compare, store and record stop ``k``'s pair."""
         T_arm = (T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
                  @ self._T_head_left)  # the arm's idea of the left camera  # fmt: skip
         located, exclude = None, None

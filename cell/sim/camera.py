@@ -104,6 +104,11 @@ class SimCamera:
             for r in world.cell.reference_targets
         }
 
+    def computing(self):
+        """The simulation's clock held while the computer works on a pair
+        (:func:`cell.camera.backend.computing`)."""
+        return self.world.clock.held()
+
     def capture(self) -> StereoPair:
         """Render the pair the head sees now (an exposure takes no simulation time)."""
         with self.world.clock.held():

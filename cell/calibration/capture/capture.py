@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from cell.calibration.capture.orient import orient_chessboard, refine_corners, repair_outliers
 from cell.calibration.estimate.soft_views import is_soft
 from cell.camera import CameraBackend
+from cell.camera.backend import computing
 from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.link.motion import Motion
@@ -185,7 +186,8 @@ class TourCapture(Motion):
     ) -> None:
         """Append the view of a finished (or awaited) detection and report it."""
         vid, st, future = job
-        (left, why_left), (right, why_right), dt = future.result()
+        with computing(self.camera):  # the arm waits at its view for the detection
+            (left, why_left), (right, why_right), dt = future.result()
         wall["detect_s"] += dt
         q = np.asarray(st.q_rad, float).copy()
         temps = np.asarray(st.temperatures_c, float).copy()  # the arm's warming (warming.py)
