@@ -14,11 +14,14 @@ from __future__ import annotations
 
 import logging
 from collections import Counter
+from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.helper import Helper, helper_arm, helper_state
 from planner.protocols import ArmLike, HoleLike
 
 log = logging.getLogger(__name__)
@@ -176,3 +179,75 @@ def hole_candidates(
         poses=poses,
         reason=reason,
     )
+
+
+@dataclass(frozen=True)
+class ViewSettings:
+    """The viewpoint settings of :class:`planner.options.Options` (deg, m)."""
+
+    standoff_m: float
+    roll_step_deg: float
+    tilt_deg: float
+    tilt_azimuths: int
+    fallback_tilt_deg: float
+
+
+def hole_viewpoints(arm: ArmLike, hole: HoleLike, s: ViewSettings) -> tuple[HoleCandidates, bool]:
+    """:func:`hole_candidates` of ``hole``; when it has none and the fallback cone is wider,
+    those of the fallback cone if any. Returns them and whether the fallback gave them."""
+    c = hole_candidates(arm, hole, s.standoff_m, s.roll_step_deg, s.tilt_deg, s.tilt_azimuths)
+    if not c.ok and s.fallback_tilt_deg > s.tilt_deg:
+        tilted = hole_candidates(
+            arm, hole, s.standoff_m, s.roll_step_deg, s.fallback_tilt_deg, s.tilt_azimuths
+        )
+        if tilted.ok:
+            return tilted, True
+    return c, False
+
+
+#: holes per chunk of work handed to the helper process (:mod:`planner.helper`)
+CHUNK = 6
+
+
+def _helper_chunk(lo: int, hi: int, s: ViewSettings) -> list[tuple[HoleCandidates, bool]]:
+    """:func:`hole_viewpoints` of the holes ``lo:hi`` (in the helper process)."""
+    holes = helper_state("holes")
+    return [hole_viewpoints(helper_arm(), h, s) for h in holes[lo:hi]]
+
+
+def all_hole_candidates(
+    arm: ArmLike,
+    holes: list[HoleLike],
+    s: ViewSettings,
+    helper: Helper | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> list[tuple[HoleCandidates, bool]]:
+    """:func:`hole_viewpoints` of every hole, in order. With a ``helper`` (forked with
+    ``holes=holes``), it takes chunks of ``CHUNK`` holes from the back while this process
+    works from the front; a chunk it has not started when this process reaches it is done
+    here (the same results, whoever computes them). ``progress(done)`` after each hole."""
+    out: list[tuple[HoleCandidates, bool] | None] = [None] * len(holes)
+    done = 0
+    chunks = [(lo, min(lo + CHUNK, len(holes))) for lo in range(0, len(holes), CHUNK)]
+    futures: dict[int, Future[list[tuple[HoleCandidates, bool]]]] = {}
+    if helper is not None:
+        for k in range(len(chunks) - 1, 0, -1):  # the back half first; never the first chunk
+            futures[k] = helper.submit(_helper_chunk, *chunks[k], s)
+    for k, (lo, hi) in enumerate(chunks):
+        f = futures.get(k)
+        if f is not None and not f.cancel():
+            break  # the helper has it (and every chunk after it)
+        for i in range(lo, hi):
+            out[i] = hole_viewpoints(arm, holes[i], s)
+            done += 1
+            if progress is not None:
+                progress(done)
+    for k, f in futures.items():
+        if not f.cancelled():
+            lo, hi = chunks[k]
+            out[lo:hi] = f.result()
+            done += hi - lo
+            if progress is not None:
+                progress(done)
+    assert all(x is not None for x in out)
+    return [x for x in out if x is not None]
