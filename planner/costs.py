@@ -111,8 +111,12 @@ class CostTable:
             grid = np.arange(int(np.ceil(span[k] * self.inv_step)) + 2) * step_rad
             self.tables.append(rest_to_rest_time(grid, v[k], a[k], j[k]).astype(np.float32))
 
-    def matrix(self, q_rows: ArrayLike, q_cols: ArrayLike) -> NDArray[np.float32]:
-        """Approximate :func:`cost_matrix` (s, float32) between the rows of two arrays (rad).
+    def matrix(
+        self, q_rows: ArrayLike, q_cols: ArrayLike, dtype: type = np.float32
+    ) -> NDArray[np.floating]:
+        """Approximate :func:`cost_matrix` (s, float32 values) between the rows of two arrays
+        (rad), as ``dtype`` (float64 holds the same values exactly; made in place, with no
+        float32 copy of the whole matrix).
 
         When ``q_cols`` is ``q_rows`` (the same object) the matrix is symmetric (the table's
         argument is ``|a - b|``, exactly the same both ways in floating point): the upper
@@ -120,9 +124,11 @@ class CostTable:
         """
         rows = np.atleast_2d(np.asarray(q_rows, dtype=float))
         if q_cols is not q_rows:
-            return self._block(rows, np.atleast_2d(np.asarray(q_cols, dtype=float)))
+            return self._block(rows, np.atleast_2d(np.asarray(q_cols, dtype=float))).astype(
+                dtype, copy=False
+            )
         n = rows.shape[0]
-        out = np.zeros((n, n), dtype=np.float32)
+        out = np.zeros((n, n), dtype=dtype)
         for i0 in range(0, n, SYMMETRIC_BLOCK):
             i1 = min(i0 + SYMMETRIC_BLOCK, n)
             block = self._block(rows[i0:i1], rows[i0:])

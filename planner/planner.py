@@ -26,6 +26,8 @@ from planner.errors import (
 )
 from planner.helper import Helper
 from planner.lazy_edges import PROBE_COARSENESS, REFINE_SHARE, LazyEdgeChecks
+from planner.lns import COMPILED_ABOVE
+from planner.lns_compile import compile_kernels
 from planner.options import Options
 from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
@@ -111,6 +113,7 @@ class TourPlanner(LazyEdgeChecks):
         each = all_hole_candidates(
             arm, holes, s, getattr(self, "_helper", None),
             lambda done: self.progress("viewpoints", done, len(holes)),
+            lambda: self._load_kernels(len(holes)),
         )  # fmt: skip
         found, left = [], []
         for hole, (c, tilted) in zip(holes, each, strict=True):
@@ -128,6 +131,12 @@ class TourPlanner(LazyEdgeChecks):
         for h in left:
             log.warning("hole %s left out: %s", h.hole_id, h.reason)
         return found, left
+
+    def _load_kernels(self, n_holes: int) -> None:
+        """Load the search's compiled kernels (Numba's cache: ~1 s of CPU in a fresh process)
+        while the helper process computes viewpoints, where the search will use them."""
+        if self.sequencer is None and self.options.sequencer == "lns" and n_holes > COMPILED_ABOVE:
+            compile_kernels()
 
     def _route(self, cands: list[HoleCandidates], res: SequenceResult) -> Route:
         pairs = list(zip(res.order, res.choice, strict=True))
@@ -296,6 +305,7 @@ class TourPlanner(LazyEdgeChecks):
                     o.nodes_per_hole,
                     o.sequencer,
                     positions_m=xyz,
+                    helper=self._helper,
                 )
                 seqr.add_task_space_nodes()  # before the roadmap: their motions are checked too
                 self._build_roadmap(seqr, checker)

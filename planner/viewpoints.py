@@ -221,11 +221,14 @@ def all_hole_candidates(
     s: ViewSettings,
     helper: Helper | None = None,
     progress: Callable[[int], None] | None = None,
+    meanwhile: Callable[[], None] | None = None,
 ) -> list[tuple[HoleCandidates, bool]]:
     """:func:`hole_viewpoints` of every hole, in order. With a ``helper`` (forked with
     ``holes=holes``), it takes chunks of ``CHUNK`` holes from the back while this process
     works from the front; a chunk it has not started when this process reaches it is done
-    here (the same results, whoever computes them). ``progress(done)`` after each hole."""
+    here (the same results, whoever computes them). ``progress(done)`` after each hole;
+    ``meanwhile()``: other work for this process, done first when there is a helper (which
+    then takes more chunks)."""
     out: list[tuple[HoleCandidates, bool] | None] = [None] * len(holes)
     done = 0
     chunks = [(lo, min(lo + CHUNK, len(holes))) for lo in range(0, len(holes), CHUNK)]
@@ -233,6 +236,8 @@ def all_hole_candidates(
     if helper is not None:
         for k in range(len(chunks) - 1, 0, -1):  # the back half first; never the first chunk
             futures[k] = helper.submit(_helper_chunk, *chunks[k], s)
+        if meanwhile is not None:
+            meanwhile()
     for k, (lo, hi) in enumerate(chunks):
         f = futures.get(k)
         if f is not None and not f.cancel():

@@ -55,3 +55,19 @@ def test_motion_checks_split_with_a_helper_equal_one_process(cell) -> None:
     assert got.tolist() == want.tolist()
     assert split.checks == alone.checks
     assert 0 < got.sum() < len(got) - 5  # both answers occur
+
+
+def test_representatives_chosen_with_a_helper_equal_those_without(cell) -> None:
+    from planner.representatives import every_representatives
+    from planner.timing import JointLimits
+
+    arm = cell.build_arm()
+    limits = JointLimits.from_arm(arm)
+    home = np.asarray(cell.home_q(), float)
+    rng = np.random.default_rng(6)
+    cands = [rng.uniform(arm.lower, arm.upper, (m, 6)) for m in (3, 40, 8, 60, 5, 9, 30, 2, 50)]
+    want = every_representatives(cands, 8, home, limits)
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
+        got = every_representatives(cands, 8, home, limits, helper)
+    assert [g.tolist() for g in got] == [w.tolist() for w in want]
+    assert any(len(w) == 8 for w in want) and any(len(w) < 8 for w in want)
