@@ -133,51 +133,45 @@ def hole_candidates(
     roll_step_deg: float,
     tilt_deg: float = 0.0,
     tilt_azimuths: int = 6,
+    known_empty: int = 0,
 ) -> HoleCandidates:
-    """Collision-free IK configurations of every viewpoint of ``hole`` (see module docstring)."""
+    """Collision-free IK configurations of every viewpoint of ``hole`` (see module docstring).
+
+    ``known_empty``: the first poses known to have no collision-free configuration (the
+    axis poses, before a fallback cone) are not solved again (the same candidates; only the
+    ``reason`` of an empty result leaves them out)."""
     poses = viewpoint_poses(
         hole.position_m, hole.normal, standoff_m, roll_step_deg, tilt_deg, tilt_azimuths
     )
-    qs, branches, pose_ids = [], [], []
     ik_reasons: Counter[str] = Counter()
-    colliding: list[NDArray[np.float64]] = []
-    n_solutions = 0
-    solved = []  # (pose, IK result, first row of each distinct arm geometry, inverse)
-    for p, T in enumerate(poses):
-        result = arm.ik(T)
+    sols, branches, pose_of = [], [], []
+    for p in range(known_empty, len(poses)):
+        result = arm.ik(poses[p])
         if not result.ok:
             ik_reasons[result.reason or "no IK solution"] += 1
             continue
-        n_solutions += len(result.solutions)
-        wrapped = np.round((result.solutions + np.pi) % (2 * np.pi) - np.pi, 9)
-        first, inverse = _distinct_rows(wrapped)
-        solved.append((p, result, first, inverse))
-    distinct = [result.solutions[first] for _, result, first, _ in solved]
-    hit = _in_collision_each(arm, np.vstack(distinct) if distinct else np.zeros((0, 6)))
-    offsets = np.cumsum([0] + [len(d) for d in distinct])
-    for (p, result, first, inverse), lo in zip(solved, offsets[:-1], strict=True):
-        free = ~hit[lo : lo + len(first)]
-        keep = free[inverse]
-        if not free.all():
-            colliding.extend(result.solutions[i] for i in first[~free])
-        qs.append(result.solutions[keep])
-        branches.append(np.asarray(result.branches)[keep])
-        pose_ids.append(np.full(int(keep.sum()), p))
-    q = np.vstack(qs) if qs else np.zeros((0, 6))
+        sols.append(result.solutions)
+        branches.append(np.asarray(result.branches, dtype=np.int64))
+        pose_of.append(np.full(len(result.solutions), p, dtype=np.int64))
+    S = np.vstack(sols) if sols else np.zeros((0, 6))
+    B = np.concatenate(branches) if branches else np.zeros(0, np.int64)
+    P = np.concatenate(pose_of) if pose_of else np.zeros(0, np.int64)
+    # each pose's distinct arm geometries (values 2*pi apart: the same), pose by pose in
+    # lexicographic order: the pose is the first key
+    wrapped = np.round((S + np.pi) % (2 * np.pi) - np.pi, 9)
+    first, inverse = _distinct_rows(np.column_stack([P.astype(float), wrapped]))
+    hit = _in_collision_each(arm, S[first])
+    keep = ~hit[inverse]
+    q = S[keep]
     reason = None
     if len(q) == 0:
-        if n_solutions:
-            reason = _describe_collisions(arm, colliding)
+        if len(S):
+            reason = _describe_collisions(arm, list(S[first[hit]]))
         else:
             reason = ", ".join(r for r, _ in ik_reasons.most_common()) or "no IK solution"
     log.debug("hole %s: %d poses, %d candidates", hole.id, len(poses), len(q))
     return HoleCandidates(
-        hole_id=hole.id,
-        q=q,
-        branch=np.concatenate(branches).astype(np.int64) if branches else np.zeros(0, np.int64),
-        pose=np.concatenate(pose_ids).astype(np.int64) if pose_ids else np.zeros(0, np.int64),
-        poses=poses,
-        reason=reason,
+        hole_id=hole.id, q=q, branch=B[keep], pose=P[keep], poses=poses, reason=reason
     )
 
 
@@ -197,8 +191,10 @@ def hole_viewpoints(arm: ArmLike, hole: HoleLike, s: ViewSettings) -> tuple[Hole
     those of the fallback cone if any. Returns them and whether the fallback gave them."""
     c = hole_candidates(arm, hole, s.standoff_m, s.roll_step_deg, s.tilt_deg, s.tilt_azimuths)
     if not c.ok and s.fallback_tilt_deg > s.tilt_deg:
+        # the first poses of both cones (the view along the axis) gave no candidate
+        axis = len(c.poses) // (1 + (s.tilt_azimuths if s.tilt_deg > 0 else 0))
         tilted = hole_candidates(
-            arm, hole, s.standoff_m, s.roll_step_deg, s.fallback_tilt_deg, s.tilt_azimuths
+            arm, hole, s.standoff_m, s.roll_step_deg, s.fallback_tilt_deg, s.tilt_azimuths, axis
         )
         if tilted.ok:
             return tilted, True
