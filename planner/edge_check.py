@@ -67,7 +67,9 @@ class BatchEdgeChecker:
             remote = helper.submit(interior_free, A[idx[half:]], B[idx[half:]], c.joint_step,
                                    c.tcp_step)  # fmt: skip
             mine = self._interiors(A[idx[:half]], B[idx[:half]], one_at_a_time=True)
-            theirs = remote.result()
+            theirs = Helper.result(
+                remote, lambda: self._interiors(A[idx[half:]], B[idx[half:]], True)
+            )
             inner_in, inner_free, sizes = (
                 np.concatenate([x, y]) for x, y in zip(mine, theirs, strict=True)
             )

@@ -19,8 +19,9 @@ from __future__ import annotations
 
 import logging
 import multiprocessing
+import time
 from collections.abc import Callable
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import BrokenExecutor, Future, ProcessPoolExecutor
 from typing import Any
 
 from planner.protocols import ArmLike
@@ -86,12 +87,32 @@ class Helper:
         return cls(pool)
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
-        """Run ``fn(*args)`` in the helper (after everything submitted before)."""
-        return self.pool.submit(fn, *args)
+        """Run ``fn(*args)`` in the helper (after everything submitted before); a helper
+        that died gives a future holding :class:`BrokenExecutor` (see :meth:`result`)."""
+        try:
+            return self.pool.submit(fn, *args)
+        except (BrokenExecutor, RuntimeError) as exc:
+            failed: Future[Any] = Future()
+            failed.set_exception(BrokenExecutor(str(exc)))
+            return failed
 
-    def close(self) -> None:
-        """Stop the helper (pending work is cancelled)."""
+    @staticmethod
+    def result(future: Future[Any], fallback: Callable[[], Any]) -> Any:
+        """The result of ``future``, or ``fallback()`` here when the helper process died."""
+        try:
+            return future.result()
+        except BrokenExecutor as exc:
+            log.warning("the helper process stopped (%s); its share runs here", exc)
+            return fallback()
+
+    def close(self) -> float:
+        """Stop the helper (pending work is cancelled); returns the CPU time (s) it used."""
+        try:
+            cpu = float(self.pool.submit(time.process_time).result())
+        except (BrokenExecutor, OSError):  # a helper that died: its time is unknown
+            cpu = 0.0
         self.pool.shutdown(wait=False, cancel_futures=True)
+        return cpu
 
     def __enter__(self) -> Helper:
         return self

@@ -311,12 +311,12 @@ class TourPlanner(LazyEdgeChecks):
                 self._build_roadmap(seqr, checker)
             timings["sequence"] = time.perf_counter() - t
         finally:
-            if self._helper is not None:
-                self._helper.close()
+            helper_cpu = self._helper.close() if self._helper is not None else 0.0
             self._helper = None
         return SharedPlan(
             cell_sha256(cell), options_key(o), home, cands, left, seqr, self._roadmap,
-            self._edge_free, checker.checks, timings, time.process_time() - cpu,
+            self._edge_free, checker.checks, timings, time.process_time() - cpu + helper_cpu,
+            helper_cpu,
         )  # fmt: skip
 
     def plan(self, cell: CellLike, shared: SharedPlan | bytes | None = None) -> Tour:
@@ -361,6 +361,7 @@ class TourPlanner(LazyEdgeChecks):
             "lazy_corridor_blocked": self._corridor,
             "roadmap_edges_blocked": sum(not f for f in self._roadmap.free.values()),
             "collision_checks": checker.checks,
+            "helper_cpu_time_s": shared.helper_cpu_time_s,
         }
         return Tour(
             cell_name=cell.name,

@@ -49,7 +49,10 @@ def every_representatives(
         assert helper is not None
         theirs = helper.submit(_representatives_of, list(candidates[half:]), k, anchor, limits)
     mine = _representatives_of(candidates[:half], k, anchor, limits)
-    return mine + (theirs.result() if theirs is not None else [])
+    if theirs is None:
+        return mine
+    rest = list(candidates[half:])
+    return mine + Helper.result(theirs, lambda: _representatives_of(rest, k, anchor, limits))
 
 
 def _representatives_of(

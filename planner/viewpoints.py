@@ -246,7 +246,9 @@ def all_hole_candidates(
     for k, f in futures.items():
         if not f.cancelled():
             lo, hi = chunks[k]
-            out[lo:hi] = f.result()
+            out[lo:hi] = Helper.result(
+                f, lambda lo=lo, hi=hi: [hole_viewpoints(arm, h, s) for h in holes[lo:hi]]
+            )
             done += hi - lo
             if progress is not None:
                 progress(done)

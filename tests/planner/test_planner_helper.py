@@ -71,3 +71,21 @@ def test_representatives_chosen_with_a_helper_equal_those_without(cell) -> None:
         got = every_representatives(cands, 8, home, limits, helper)
     assert [g.tolist() for g in got] == [w.tolist() for w in want]
     assert any(len(w) == 8 for w in want) and any(len(w) < 8 for w in want)
+
+
+def test_a_helper_that_died_leaves_its_share_to_this_process(cell) -> None:
+    import os
+    import signal
+
+    arm = cell.build_arm()
+    holes = cell.holes_in_cell()[: 2 * CHUNK + 1]
+    s = ViewSettings(cell.tool.standoff_m, 60.0, 0.0, 6, 10.0)
+    want = all_hole_candidates(arm, holes, s)
+    helper = Helper.start(MIN_HOLES, arm=arm, holes=holes)
+    for pid in list(helper.pool._processes):
+        os.kill(pid, signal.SIGKILL)
+    got = all_hole_candidates(arm, holes, s, helper)
+    assert helper.close() == 0.0
+    assert [np.array_equal(a.q, b.q) for (a, _), (b, _) in zip(got, want, strict=True)] == [
+        True
+    ] * len(holes)
