@@ -11,8 +11,12 @@ against ruckig itself.
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+_F = TypeVar("_F", np.float32, np.float64)
 
 
 def rest_to_rest_time(
@@ -111,12 +115,8 @@ class CostTable:
             grid = np.arange(int(np.ceil(span[k] * self.inv_step)) + 2) * step_rad
             self.tables.append(rest_to_rest_time(grid, v[k], a[k], j[k]).astype(np.float32))
 
-    def matrix(
-        self, q_rows: ArrayLike, q_cols: ArrayLike, dtype: type = np.float32
-    ) -> NDArray[np.floating]:
-        """Approximate :func:`cost_matrix` (s, float32 values) between the rows of two arrays
-        (rad), as ``dtype`` (float64 holds the same values exactly; made in place, with no
-        float32 copy of the whole matrix).
+    def matrix(self, q_rows: ArrayLike, q_cols: ArrayLike) -> NDArray[np.float32]:
+        """Approximate :func:`cost_matrix` (s, float32) between the rows of two arrays (rad).
 
         When ``q_cols`` is ``q_rows`` (the same object) the matrix is symmetric (the table's
         argument is ``|a - b|``, exactly the same both ways in floating point): the upper
@@ -124,11 +124,19 @@ class CostTable:
         """
         rows = np.atleast_2d(np.asarray(q_rows, dtype=float))
         if q_cols is not q_rows:
-            return self._block(rows, np.atleast_2d(np.asarray(q_cols, dtype=float))).astype(
-                dtype, copy=False
-            )
+            return self._block(rows, np.atleast_2d(np.asarray(q_cols, dtype=float)))
         n = rows.shape[0]
-        out = np.zeros((n, n), dtype=dtype)
+        return self._symmetric(rows, np.zeros((n, n), dtype=np.float32))
+
+    def matrix64(self, q: ArrayLike) -> NDArray[np.float64]:
+        """``matrix(q, q)`` as float64 (the same values), made in place: no float32 copy of
+        the whole matrix (250 holes: 58 MB less, and one pass over it fewer)."""
+        rows = np.atleast_2d(np.asarray(q, dtype=float))
+        n = rows.shape[0]
+        return self._symmetric(rows, np.zeros((n, n), dtype=np.float64))
+
+    def _symmetric(self, rows: NDArray[np.float64], out: NDArray[_F]) -> NDArray[_F]:
+        n = rows.shape[0]
         for i0 in range(0, n, SYMMETRIC_BLOCK):
             i1 = min(i0 + SYMMETRIC_BLOCK, n)
             block = self._block(rows[i0:i1], rows[i0:])

@@ -118,8 +118,11 @@ class BatchEdgeChecker:
             return self.batch.any_hit(trajs)
         # one configuration per call (the pool's answers; its C++ loop costs ~40 % more CPU
         # per configuration on one thread), or a stand-in without a Pinocchio model
-        collision = getattr(self.checker.arm, "collision", None)
-        check = collision.in_collision if self.batch is not None else self.checker.arm.in_collision
+        check = (
+            self.batch.collision.in_collision
+            if self.batch is not None
+            else self.checker.arm.in_collision
+        )
         return np.array(
             [any(check(q) for q in np.ascontiguousarray(Q.T)) for Q in trajs], dtype=bool
         )

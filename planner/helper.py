@@ -47,11 +47,6 @@ def helper_arm() -> ArmLike:
     return _STATE["arm"]
 
 
-def helper_state(key: str) -> Any:
-    """A value the forking process left for its helper's tasks (in the helper process)."""
-    return _STATE[key]
-
-
 class Helper:
     """One forked process that runs submitted top-level functions, in submission order."""
 

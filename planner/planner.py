@@ -283,7 +283,7 @@ class TourPlanner(LazyEdgeChecks):
         limits = JointLimits.from_arm(arm)
         home = self._home(arm, cell)
         checker = MotionChecker(arm, np.radians(o.joint_step_deg), o.tcp_step_m)
-        self._helper = Helper.start(len(cell.holes_in_cell()), arm=arm, holes=cell.holes_in_cell())
+        self._helper = Helper.start(len(cell.holes_in_cell()), arm=arm)
         try:
             t = time.perf_counter()
             cands, left = self._viewpoints(arm, cell)

@@ -198,7 +198,7 @@ class GtspSequencer:
         table = CostTable(
             limits.velocity, limits.acceleration, limits.jerk, limits.upper - limits.lower
         )
-        self.G = table.matrix(self.nodes, self.nodes, np.float64)
+        self.G = table.matrix64(self.nodes)
         self.table = table
         self.positions_m = None if positions_m is None else np.asarray(positions_m, float)
         self.task_order: list[int] | None = None  # add_task_space_nodes

@@ -17,11 +17,12 @@ from collections import Counter
 from collections.abc import Callable
 from concurrent.futures import Future
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
 
-from planner.helper import Helper, helper_arm, helper_state
+from planner.helper import Helper, helper_arm
 from planner.protocols import ArmLike, HoleLike
 
 log = logging.getLogger(__name__)
@@ -205,10 +206,24 @@ def hole_viewpoints(arm: ArmLike, hole: HoleLike, s: ViewSettings) -> tuple[Hole
 CHUNK = 6
 
 
-def _helper_chunk(lo: int, hi: int, s: ViewSettings) -> list[tuple[HoleCandidates, bool]]:
-    """:func:`hole_viewpoints` of the holes ``lo:hi`` (in the helper process)."""
-    holes = helper_state("holes")
-    return [hole_viewpoints(helper_arm(), h, s) for h in holes[lo:hi]]
+@dataclass
+class _Hole:
+    """What a hole's viewpoints need of it (sent to the helper process)."""
+
+    id: str
+    position_m: NDArray[np.float64]
+    normal: NDArray[np.float64]
+
+
+def _chunk_here(
+    arm: ArmLike, holes: list[HoleLike], s: ViewSettings
+) -> list[tuple[HoleCandidates, bool]]:
+    return [hole_viewpoints(arm, h, s) for h in holes]
+
+
+def _helper_chunk(holes: list[_Hole], s: ViewSettings) -> list[tuple[HoleCandidates, bool]]:
+    """:func:`hole_viewpoints` of ``holes`` (in the helper process)."""
+    return [hole_viewpoints(helper_arm(), h, s) for h in holes]
 
 
 def all_hole_candidates(
@@ -219,19 +234,22 @@ def all_hole_candidates(
     progress: Callable[[int], None] | None = None,
     meanwhile: Callable[[], None] | None = None,
 ) -> list[tuple[HoleCandidates, bool]]:
-    """:func:`hole_viewpoints` of every hole, in order. With a ``helper`` (forked with
-    ``holes=holes``), it takes chunks of ``CHUNK`` holes from the back while this process
-    works from the front; a chunk it has not started when this process reaches it is done
-    here (the same results, whoever computes them). ``progress(done)`` after each hole;
-    ``meanwhile()``: other work for this process, done first when there is a helper (which
-    then takes more chunks)."""
+    """:func:`hole_viewpoints` of every hole, in order. With a ``helper``, it takes chunks
+    of ``CHUNK`` holes from the back while this process works from the front; a chunk it
+    has not started when this process reaches it is done here (the same results, whoever
+    computes them). ``progress(done)`` after each hole; ``meanwhile()``: other work for
+    this process, done first when there is a helper (which then takes more chunks)."""
     out: list[tuple[HoleCandidates, bool] | None] = [None] * len(holes)
     done = 0
     chunks = [(lo, min(lo + CHUNK, len(holes))) for lo in range(0, len(holes), CHUNK)]
     futures: dict[int, Future[list[tuple[HoleCandidates, bool]]]] = {}
     if helper is not None:
-        for k in range(len(chunks) - 1, 0, -1):  # the back half first; never the first chunk
-            futures[k] = helper.submit(_helper_chunk, *chunks[k], s)
+        for k in range(len(chunks) - 1, 0, -1):  # last chunk first; the first stays here
+            lo, hi = chunks[k]
+            sent = [
+                _Hole(h.id, np.asarray(h.position_m), np.asarray(h.normal)) for h in holes[lo:hi]
+            ]
+            futures[k] = helper.submit(_helper_chunk, sent, s)
         if meanwhile is not None:
             meanwhile()
     for k, (lo, hi) in enumerate(chunks):
@@ -246,9 +264,8 @@ def all_hole_candidates(
     for k, f in futures.items():
         if not f.cancelled():
             lo, hi = chunks[k]
-            out[lo:hi] = Helper.result(
-                f, lambda lo=lo, hi=hi: [hole_viewpoints(arm, h, s) for h in holes[lo:hi]]
-            )
+            here = partial(_chunk_here, arm, holes[lo:hi], s)
+            out[lo:hi] = Helper.result(f, here)
             done += hi - lo
             if progress is not None:
                 progress(done)

@@ -29,7 +29,7 @@ def test_viewpoints_with_a_helper_equal_those_without(cell) -> None:
     s = ViewSettings(cell.tool.standoff_m, 30.0, 0.0, 6, 10.0)
     want = all_hole_candidates(arm, holes, s)
     seen: list[int] = []
-    with Helper.start(MIN_HOLES, arm=arm, holes=holes) as helper:
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
         got = all_hole_candidates(arm, holes, s, helper, seen.append)
     assert seen[-1] == len(holes) and sorted(seen) == seen
     assert len(got) == len(want)
@@ -81,7 +81,7 @@ def test_a_helper_that_died_leaves_its_share_to_this_process(cell) -> None:
     holes = cell.holes_in_cell()[: 2 * CHUNK + 1]
     s = ViewSettings(cell.tool.standoff_m, 60.0, 0.0, 6, 10.0)
     want = all_hole_candidates(arm, holes, s)
-    helper = Helper.start(MIN_HOLES, arm=arm, holes=holes)
+    helper = Helper.start(MIN_HOLES, arm=arm)
     for pid in list(helper.pool._processes):
         os.kill(pid, signal.SIGKILL)
     got = all_hole_candidates(arm, holes, s, helper)
