@@ -11,8 +11,12 @@ against ruckig itself.
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+_F = TypeVar("_F", np.float32, np.float64)
 
 
 def rest_to_rest_time(
@@ -122,7 +126,17 @@ class CostTable:
         if q_cols is not q_rows:
             return self._block(rows, np.atleast_2d(np.asarray(q_cols, dtype=float)))
         n = rows.shape[0]
-        out = np.zeros((n, n), dtype=np.float32)
+        return self._symmetric(rows, np.zeros((n, n), dtype=np.float32))
+
+    def matrix64(self, q: ArrayLike) -> NDArray[np.float64]:
+        """``matrix(q, q)`` as float64 (the same values), made in place: no float32 copy of
+        the whole matrix (250 holes: 58 MB less, and one pass over it fewer)."""
+        rows = np.atleast_2d(np.asarray(q, dtype=float))
+        n = rows.shape[0]
+        return self._symmetric(rows, np.zeros((n, n), dtype=np.float64))
+
+    def _symmetric(self, rows: NDArray[np.float64], out: NDArray[_F]) -> NDArray[_F]:
+        n = rows.shape[0]
         for i0 in range(0, n, SYMMETRIC_BLOCK):
             i1 = min(i0 + SYMMETRIC_BLOCK, n)
             block = self._block(rows[i0:i1], rows[i0:])

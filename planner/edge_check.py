@@ -15,9 +15,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.helper import Helper, helper_arm
 from planner.paths import MotionChecker, _interpolation_order
 from planner.sampling import interior_samples, motion_counts
 from robots.collision_batch import BatchCollision
+
+#: with a helper process, each process checks at least this many motions (else one does all)
+HELPER_MIN_MOTIONS = 500
 
 
 class BatchEdgeChecker:
@@ -37,12 +41,58 @@ class BatchEdgeChecker:
         c = self.checker
         return motion_counts(c.arm, c.joint_step, c.tcp_step, A, B)
 
-    def free(self, starts: NDArray[np.float64], ends: NDArray[np.float64]) -> NDArray[np.bool_]:
+    def free(
+        self,
+        starts: NDArray[np.float64],
+        ends: NDArray[np.float64],
+        helper: Helper | None = None,
+    ) -> NDArray[np.bool_]:
         """For each row pair (``starts[i]`` → ``ends[i]``, rad): True when the straight motion
-        is within the limits and free of collision at the checker's resolution."""
+        is within the limits and free of collision at the checker's resolution.
+
+        ``helper`` (:class:`planner.helper.Helper`): the second half of the motions' interior
+        samples is checked in the helper process while this one checks the first half, each
+        one configuration at a time (the same answers and counts as one process)."""
         A, B = np.asarray(starts, dtype=float), np.asarray(ends, dtype=float)
+        out = np.zeros(len(A), dtype=bool)
         if not len(A):
-            return np.zeros(0, dtype=bool)
+            return out
+        lo, hi = self.checker.lower, self.checker.upper
+        last = A + 1.0 * (B - A)  # the last sample of np.linspace's motion
+        ends_in = np.all((lo <= A) & (hi >= A) & (last >= lo) & (last <= hi), axis=1)
+        idx = np.flatnonzero(ends_in)
+        if helper is not None and len(idx) >= 2 * HELPER_MIN_MOTIONS:
+            half = len(idx) // 2
+            c = self.checker
+            remote = helper.submit(interior_free, A[idx[half:]], B[idx[half:]], c.joint_step,
+                                   c.tcp_step)  # fmt: skip
+            mine = self._interiors(A[idx[:half]], B[idx[:half]], one_at_a_time=True)
+            theirs = Helper.result(
+                remote, lambda: self._interiors(A[idx[half:]], B[idx[half:]], True)
+            )
+            inner_in, inner_free, sizes = (
+                np.concatenate([x, y]) for x, y in zip(mine, theirs, strict=True)
+            )
+        else:
+            inner_in, inner_free, sizes = self._interiors(A[idx], B[idx])
+        todo = idx[inner_in]
+        if not len(todo):
+            return out
+        # the motions share their ends (each node is the end of many): every distinct end
+        # configuration is checked once
+        uniq, which = np.unique(np.vstack([A[todo], B[todo]]), axis=0, return_inverse=True)
+        which = which.reshape(2, len(todo))
+        self.checks += len(uniq) + int(sizes[inner_in].sum())
+        end_free = ~self._hits([e[:, None] for e in uniq])
+        out[todo] = end_free[which[0]] & end_free[which[1]] & inner_free[inner_in]
+        return out
+
+    def _interiors(
+        self, A: NDArray[np.float64], B: NDArray[np.float64], one_at_a_time: bool = False
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.int64]]:
+        """Per motion: its interior samples within the limits; (where they are) free of
+        collision, each motion's checked coarse to fine up to its first collision; their
+        count. ``one_at_a_time``: one configuration per call, never the thread pool."""
         n = self._counts(A, B)
         # every motion's interior samples, coarse to fine (the order of MotionChecker), in one
         # array: row j of motion i is A_i + t (B_i - A_i) with t = k / n_i as np.linspace
@@ -53,27 +103,35 @@ class BatchEdgeChecker:
         inner_in = np.ones(len(A), dtype=bool)
         has = sizes > 0
         inner_in[has] = np.logical_and.reduceat(row_in, bounds[:-1][has])
-        last = A + 1.0 * (B - A)  # the last sample of np.linspace's motion
-        ends_in = np.all((lo <= A) & (hi >= A) & (last >= lo) & (last <= hi), axis=1)
-        out = np.zeros(len(A), dtype=bool)
-        todo = np.flatnonzero(inner_in & ends_in)
-        if not len(todo):
-            return out
-        # the motions share their ends (each node is the end of many): every distinct end
-        # configuration is checked once, each motion's interior samples in its own trajectory
-        uniq, which = np.unique(np.vstack([A[todo], B[todo]]), axis=0, return_inverse=True)
-        which = which.reshape(2, len(todo))
         QT = Q.T  # (dof, samples), Fortran order: each motion's columns are one block
+        todo = np.flatnonzero(inner_in)
         inner = [QT[:, bounds[i] : bounds[i + 1]] for i in todo]
-        self.checks += len(uniq) + int(sizes[todo].sum())
-        end_free = ~self._hits([e[:, None] for e in uniq])
-        inner_free = ~self._hits(inner)
-        out[todo] = end_free[which[0]] & end_free[which[1]] & inner_free
-        return out
+        free = np.zeros(len(A), dtype=bool)
+        free[todo] = ~self._hits(inner, one_at_a_time)
+        return inner_in, free, sizes
 
-    def _hits(self, trajs: list[NDArray[np.float64]]) -> NDArray[np.bool_]:
+    def _hits(
+        self, trajs: list[NDArray[np.float64]], one_at_a_time: bool = False
+    ) -> NDArray[np.bool_]:
         """For each trajectory (columns: configurations, (dof, m)): True when one collides."""
-        if self.batch is not None:
+        if self.batch is not None and not one_at_a_time:
             return self.batch.any_hit(trajs)
-        arm = self.checker.arm  # a stand-in without a Pinocchio model: one at a time
-        return np.array([any(arm.in_collision(q) for q in Q.T) for Q in trajs], dtype=bool)
+        # one configuration per call (the pool's answers; its C++ loop costs ~40 % more CPU
+        # per configuration on one thread), or a stand-in without a Pinocchio model
+        check = (
+            self.batch.collision.in_collision
+            if self.batch is not None
+            else self.checker.arm.in_collision
+        )
+        return np.array(
+            [any(check(q) for q in np.ascontiguousarray(Q.T)) for Q in trajs], dtype=bool
+        )
+
+
+def interior_free(
+    A: NDArray[np.float64], B: NDArray[np.float64], joint_step: float, tcp_step: float
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.int64]]:
+    """:meth:`BatchEdgeChecker._interiors` of the helper process's arm (run there, one
+    configuration at a time: :mod:`planner.helper`)."""
+    checker = MotionChecker(helper_arm(), joint_step, tcp_step)
+    return BatchEdgeChecker(checker, threads=1)._interiors(A, B, one_at_a_time=True)

@@ -88,13 +88,13 @@ def improve_path_near(
     """A local optimum of the neighbour moves (:func:`_best_near_move`) from the order of
     ``path``: each hole in a queue (first all, in path order) applies its best improving
     move; the holes at the ends of the edges a move changed join the queue again ("don't
-    look bits"). ``C`` must be symmetric. Returns the permutation of path positions."""
+    look bits"). ``G`` must be symmetric. Returns the permutation of path positions."""
     n = path.shape[0]
-    C = np.empty((n, n))
-    for a in range(n):
-        for b in range(n):
-            C[a, b] = G[path[a], path[b]]
     p = np.arange(n)
+    # the moves read G at the nodes of the current order, v = path[p] (moved with p): the
+    # entries of the path's cost matrix C[p[i], p[j]] = G[v[i], v[j]], without building C
+    # (n² scattered reads of G per call, most of the call when a tour is near its optimum)
+    v = path.copy()
     holes = near.shape[0]
     pos = _positions(p, order, holes)
     queue = np.empty(n - 2 + 6 * max_moves, dtype=np.int64)
@@ -109,7 +109,7 @@ def improve_path_near(
         h = queue[head]
         head += 1
         queued[h] = False
-        _d, kind, bi, bj, blen, brev = _best_near_move(C, p, pos, pos[h], near[h])
+        _d, kind, bi, bj, blen, brev = _best_near_move(G, v, pos, pos[h], near[h])
         if kind < 0:
             continue
         moves += 1
@@ -119,6 +119,7 @@ def improve_path_near(
             e = bi + blen - 1
             touched = np.array([p[bi - 1], p[bi], p[e], p[e + 1], p[bj], p[bj + 1]])
         p = apply_move(p, kind, bi, bj, blen, brev)
+        v = apply_move(v, kind, bi, bj, blen, brev)
         pos = _positions(p, order, holes)
         for q in touched:
             if 1 <= q <= n - 2 and not queued[order[q - 1]]:

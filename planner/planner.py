@@ -24,7 +24,10 @@ from planner.errors import (
     StartConfigurationError,
     UnreachableHoleError,
 )
+from planner.helper import Helper
 from planner.lazy_edges import PROBE_COARSENESS, REFINE_SHARE, LazyEdgeChecks
+from planner.lns import COMPILED_ABOVE
+from planner.lns_compile import compile_kernels
 from planner.options import Options
 from planner.paths import MotionChecker
 from planner.protocols import ArmLike, CellLike
@@ -37,7 +40,7 @@ from planner.shared import SharedPlan, options_key, unpack
 from planner.timing import JointLimits
 from planner.tour import LeftOut, Tour
 from planner.trajectory import sample_timeline
-from planner.viewpoints import HoleCandidates, hole_candidates
+from planner.viewpoints import HoleCandidates, ViewSettings, all_hole_candidates
 
 __all__ = [
     "STAGES",
@@ -104,30 +107,22 @@ class TourPlanner(LazyEdgeChecks):
     ) -> tuple[list[HoleCandidates], list[LeftOut]]:
         o = self.options
         holes = cell.holes_in_cell()
+        s = ViewSettings(
+            cell.tool.standoff_m, o.roll_step_deg, o.tilt_deg, o.tilt_azimuths, o.fallback_tilt_deg
+        )
+        each = all_hole_candidates(
+            arm, holes, s, getattr(self, "_helper", None),
+            lambda done: self.progress("viewpoints", done, len(holes)),
+            lambda: self._load_kernels(len(holes)),
+        )  # fmt: skip
         found, left = [], []
-        for i, hole in enumerate(holes):
-            c = hole_candidates(
-                arm, hole, cell.tool.standoff_m, o.roll_step_deg, o.tilt_deg, o.tilt_azimuths
-            )
-            if not c.ok and o.fallback_tilt_deg > o.tilt_deg:
-                tilted = hole_candidates(
-                    arm,
-                    hole,
-                    cell.tool.standoff_m,
-                    o.roll_step_deg,
-                    o.fallback_tilt_deg,
-                    o.tilt_azimuths,
-                )
-                if tilted.ok:
-                    log.info(
-                        "hole %s: viewed up to %g deg off its axis", hole.id, o.fallback_tilt_deg
-                    )
-                    c = tilted
+        for hole, (c, tilted) in zip(holes, each, strict=True):
+            if tilted:
+                log.info("hole %s: viewed up to %g deg off its axis", hole.id, o.fallback_tilt_deg)
             if c.ok:
                 found.append(c)
             else:
                 left.append(LeftOut(hole.id, c.reason or "no viewpoint"))
-            self.progress("viewpoints", i + 1, len(holes))
         reasons = {h.hole_id: h.reason for h in left}
         if not found:
             raise NoReachableHoleError(reasons)
@@ -136,6 +131,12 @@ class TourPlanner(LazyEdgeChecks):
         for h in left:
             log.warning("hole %s left out: %s", h.hole_id, h.reason)
         return found, left
+
+    def _load_kernels(self, n_holes: int) -> None:
+        """Load the search's compiled kernels (Numba's cache: ~1 s of CPU in a fresh process)
+        while the helper process computes viewpoints, where the search will use them."""
+        if self.sequencer is None and self.options.sequencer == "lns" and n_holes > COMPILED_ABOVE:
+            compile_kernels()
 
     def _route(self, cands: list[HoleCandidates], res: SequenceResult) -> Route:
         pairs = list(zip(res.order, res.choice, strict=True))
@@ -185,7 +186,8 @@ class TourPlanner(LazyEdgeChecks):
         if k <= 0:
             return
         coarse = BatchEdgeChecker(checker.coarser(ROADMAP_COARSENESS))
-        self._roadmap = build_roadmap(seqr.nodes, seqr.G, seqr.owner, coarse, k)
+        helper = getattr(self, "_helper", None)
+        self._roadmap = build_roadmap(seqr.nodes, seqr.G, seqr.owner, coarse, k, helper)
         checker.checks += coarse.checks
         blocked = []
         for (u, v), free in self._roadmap.free.items():
@@ -281,28 +283,40 @@ class TourPlanner(LazyEdgeChecks):
         limits = JointLimits.from_arm(arm)
         home = self._home(arm, cell)
         checker = MotionChecker(arm, np.radians(o.joint_step_deg), o.tcp_step_m)
-        t = time.perf_counter()
-        cands, left = self._viewpoints(arm, cell)
-        timings = {"viewpoints": time.perf_counter() - t}
-        t = time.perf_counter()
-        self._edge_free: dict[tuple[int, int], bool] = {}
-        self._roadmap = Roadmap()
-        seqr = None
-        if self.sequencer is None:
-            self.progress("sequence", 0, 1)
-            # viewpoint positions (home's TCP first): the polish's task-space start
-            xyz = np.vstack(
-                [tcp_positions(arm, home[None, :])] + [c.poses[0][:3, 3] for c in cands]
-            )
-            seqr = GtspSequencer(
-                home, [c.q for c in cands], limits, o.nodes_per_hole, o.sequencer, positions_m=xyz
-            )
-            seqr.add_task_space_nodes()  # before the roadmap: their motions are checked too
-            self._build_roadmap(seqr, checker)
-        timings["sequence"] = time.perf_counter() - t
+        self._helper = Helper.start(len(cell.holes_in_cell()), arm=arm)
+        try:
+            t = time.perf_counter()
+            cands, left = self._viewpoints(arm, cell)
+            timings = {"viewpoints": time.perf_counter() - t}
+            t = time.perf_counter()
+            self._edge_free: dict[tuple[int, int], bool] = {}
+            self._roadmap = Roadmap()
+            seqr = None
+            if self.sequencer is None:
+                self.progress("sequence", 0, 1)
+                # viewpoint positions (home's TCP first): the polish's task-space start
+                xyz = np.vstack(
+                    [tcp_positions(arm, home[None, :])] + [c.poses[0][:3, 3] for c in cands]
+                )
+                seqr = GtspSequencer(
+                    home,
+                    [c.q for c in cands],
+                    limits,
+                    o.nodes_per_hole,
+                    o.sequencer,
+                    positions_m=xyz,
+                    helper=self._helper,
+                )
+                seqr.add_task_space_nodes()  # before the roadmap: their motions are checked too
+                self._build_roadmap(seqr, checker)
+            timings["sequence"] = time.perf_counter() - t
+        finally:
+            helper_cpu = self._helper.close() if self._helper is not None else 0.0
+            self._helper = None
         return SharedPlan(
             cell_sha256(cell), options_key(o), home, cands, left, seqr, self._roadmap,
-            self._edge_free, checker.checks, timings, time.process_time() - cpu,
+            self._edge_free, checker.checks, timings, time.process_time() - cpu + helper_cpu,
+            helper_cpu,
         )  # fmt: skip
 
     def plan(self, cell: CellLike, shared: SharedPlan | bytes | None = None) -> Tour:
@@ -347,6 +361,7 @@ class TourPlanner(LazyEdgeChecks):
             "lazy_corridor_blocked": self._corridor,
             "roadmap_edges_blocked": sum(not f for f in self._roadmap.free.values()),
             "collision_checks": checker.checks,
+            "helper_cpu_time_s": shared.helper_cpu_time_s,
         }
         return Tour(
             cell_name=cell.name,

@@ -25,6 +25,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from planner.edge_check import BatchEdgeChecker
+from planner.helper import Helper
 
 #: estimated duration of a colliding straight motion without a roadmap detour: factor, extra s
 DETOUR_FACTOR = 1.5
@@ -116,13 +117,15 @@ def build_roadmap(
     owner: NDArray[np.int64],
     checker: BatchEdgeChecker,
     k: int,
+    helper: Helper | None = None,
 ) -> Roadmap:
-    """Check the ``k``-nearest motions of every node in one batch (see module docstring)."""
+    """Check the ``k``-nearest motions of every node in one batch (see module docstring),
+    half of them in the ``helper`` process if given (:mod:`planner.helper`)."""
     pairs = neighbour_pairs(G, owner, k)
     rm = Roadmap()
     if not len(pairs):
         return rm
-    ok = checker.free(nodes[pairs[:, 0]], nodes[pairs[:, 1]])
+    ok = checker.free(nodes[pairs[:, 0]], nodes[pairs[:, 1]], helper)
     rm.checked = len(pairs)
     for (u, v), f in zip(pairs.tolist(), ok.tolist(), strict=True):
         rm.free[(u, v)] = f

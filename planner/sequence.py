@@ -28,8 +28,10 @@ from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 from planner.costs import CostTable, cost_matrix, travel_time
 from planner.errors import PlanningError
 from planner.full_choice import layered_choice, task_space_order
+from planner.helper import Helper
 from planner.lns import NEAR_ABOVE, GtspLns, LnsSettings, near_holes
 from planner.pyvrp_gtsp import solve_gtsp_pyvrp
+from planner.representatives import every_representatives
 from planner.timing import JointLimits
 
 #: integer cost units per second handed to OR-Tools (10 µs resolution)
@@ -103,26 +105,6 @@ def layered_best(
     return choice[::-1], float(total[last])
 
 
-def representatives(
-    candidates: NDArray[np.float64], k: int, anchor: NDArray[np.float64], limits: JointLimits
-) -> NDArray[np.int64]:
-    """Indices of at most ``k`` candidates spread out in travel time (farthest-point sampling).
-
-    Starts from the candidate nearest ``anchor`` (rad), so the choice is deterministic.
-    """
-    n = len(candidates)
-    if n <= k:
-        return np.arange(n)
-    lim = (limits.velocity, limits.acceleration, limits.jerk)
-    chosen = [int(np.argmin(travel_time(candidates, anchor, *lim)))]
-    nearest = travel_time(candidates, candidates[chosen[0]], *lim)
-    for _ in range(k - 1):
-        nxt = int(np.argmax(nearest))
-        chosen.append(nxt)
-        nearest = np.minimum(nearest, travel_time(candidates, candidates[nxt], *lim))
-    return np.array(sorted(chosen))
-
-
 def _search_parameters(time_limit_s: float, solution_limit: int) -> object:
     params = pywrapcp.DefaultRoutingSearchParameters()
     params.first_solution_strategy = (
@@ -193,7 +175,9 @@ class GtspSequencer:
         method: str = "lns",
         max_nodes: int = 4000,
         positions_m: NDArray[np.float64] | None = None,
+        helper: Helper | None = None,
     ) -> None:
+        """``helper`` (:mod:`planner.helper`): chooses half of the holes' representatives."""
         if method not in SEQUENCERS:
             raise PlanningError(
                 f"unknown sequencing method {method!r} (use one of {', '.join(SEQUENCERS)})"
@@ -204,7 +188,7 @@ class GtspSequencer:
         self.home = np.asarray(home_q, dtype=float)
         self.candidates = [np.asarray(c, dtype=float) for c in candidates]
         k = max(min(nodes_per_hole, max_nodes // len(self.candidates)), min(nodes_per_hole, 4))
-        self.reps = [representatives(c, k, self.home, limits) for c in self.candidates]
+        self.reps = every_representatives(self.candidates, k, self.home, limits, helper)
         stacked = [c[r] for c, r in zip(self.candidates, self.reps, strict=True)]
         self.nodes = np.vstack([self.home[None, :], *stacked])
         self.owner = np.concatenate([[-1]] + [np.full(len(r), h) for h, r in enumerate(self.reps)])
@@ -214,7 +198,7 @@ class GtspSequencer:
         table = CostTable(
             limits.velocity, limits.acceleration, limits.jerk, limits.upper - limits.lower
         )
-        self.G = table.matrix(self.nodes, self.nodes).astype(np.float64)
+        self.G = table.matrix64(self.nodes)
         self.table = table
         self.positions_m = None if positions_m is None else np.asarray(positions_m, float)
         self.task_order: list[int] | None = None  # add_task_space_nodes

@@ -48,7 +48,8 @@ class SharedPlan:
     edge_free: dict[tuple[int, int], bool]
     collision_checks: int
     timings_s: dict[str, float] = field(default_factory=dict)
-    cpu_time_s: float = 0.0
+    cpu_time_s: float = 0.0  # this process's and the helper's (planner.helper)
+    helper_cpu_time_s: float = 0.0
 
     def check(self, cell_sha256: str, options: Any) -> None:
         """Raise :class:`PlanningError` unless this was prepared for that cell and options."""

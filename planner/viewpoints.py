@@ -14,11 +14,15 @@ from __future__ import annotations
 
 import logging
 from collections import Counter
+from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
 
+from planner.helper import Helper, helper_arm
 from planner.protocols import ArmLike, HoleLike
 
 log = logging.getLogger(__name__)
@@ -130,49 +134,140 @@ def hole_candidates(
     roll_step_deg: float,
     tilt_deg: float = 0.0,
     tilt_azimuths: int = 6,
+    known_empty: int = 0,
 ) -> HoleCandidates:
-    """Collision-free IK configurations of every viewpoint of ``hole`` (see module docstring)."""
+    """Collision-free IK configurations of every viewpoint of ``hole`` (see module docstring).
+
+    ``known_empty``: the first poses known to have no collision-free configuration (the
+    axis poses, before a fallback cone) are not solved again (the same candidates; only the
+    ``reason`` of an empty result leaves them out)."""
     poses = viewpoint_poses(
         hole.position_m, hole.normal, standoff_m, roll_step_deg, tilt_deg, tilt_azimuths
     )
-    qs, branches, pose_ids = [], [], []
     ik_reasons: Counter[str] = Counter()
-    colliding: list[NDArray[np.float64]] = []
-    n_solutions = 0
-    solved = []  # (pose, IK result, first row of each distinct arm geometry, inverse)
-    for p, T in enumerate(poses):
-        result = arm.ik(T)
+    sols, branches, pose_of = [], [], []
+    for p in range(known_empty, len(poses)):
+        result = arm.ik(poses[p])
         if not result.ok:
             ik_reasons[result.reason or "no IK solution"] += 1
             continue
-        n_solutions += len(result.solutions)
-        wrapped = np.round((result.solutions + np.pi) % (2 * np.pi) - np.pi, 9)
-        first, inverse = _distinct_rows(wrapped)
-        solved.append((p, result, first, inverse))
-    distinct = [result.solutions[first] for _, result, first, _ in solved]
-    hit = _in_collision_each(arm, np.vstack(distinct) if distinct else np.zeros((0, 6)))
-    offsets = np.cumsum([0] + [len(d) for d in distinct])
-    for (p, result, first, inverse), lo in zip(solved, offsets[:-1], strict=True):
-        free = ~hit[lo : lo + len(first)]
-        keep = free[inverse]
-        if not free.all():
-            colliding.extend(result.solutions[i] for i in first[~free])
-        qs.append(result.solutions[keep])
-        branches.append(np.asarray(result.branches)[keep])
-        pose_ids.append(np.full(int(keep.sum()), p))
-    q = np.vstack(qs) if qs else np.zeros((0, 6))
+        sols.append(result.solutions)
+        branches.append(np.asarray(result.branches, dtype=np.int64))
+        pose_of.append(np.full(len(result.solutions), p, dtype=np.int64))
+    S = np.vstack(sols) if sols else np.zeros((0, 6))
+    B = np.concatenate(branches) if branches else np.zeros(0, np.int64)
+    P = np.concatenate(pose_of) if pose_of else np.zeros(0, np.int64)
+    # each pose's distinct arm geometries (values 2*pi apart: the same), pose by pose in
+    # lexicographic order: the pose is the first key
+    wrapped = np.round((S + np.pi) % (2 * np.pi) - np.pi, 9)
+    first, inverse = _distinct_rows(np.column_stack([P.astype(float), wrapped]))
+    hit = _in_collision_each(arm, S[first])
+    keep = ~hit[inverse]
+    q = S[keep]
     reason = None
     if len(q) == 0:
-        if n_solutions:
-            reason = _describe_collisions(arm, colliding)
+        if len(S):
+            reason = _describe_collisions(arm, list(S[first[hit]]))
         else:
             reason = ", ".join(r for r, _ in ik_reasons.most_common()) or "no IK solution"
     log.debug("hole %s: %d poses, %d candidates", hole.id, len(poses), len(q))
     return HoleCandidates(
-        hole_id=hole.id,
-        q=q,
-        branch=np.concatenate(branches).astype(np.int64) if branches else np.zeros(0, np.int64),
-        pose=np.concatenate(pose_ids).astype(np.int64) if pose_ids else np.zeros(0, np.int64),
-        poses=poses,
-        reason=reason,
+        hole_id=hole.id, q=q, branch=B[keep], pose=P[keep], poses=poses, reason=reason
     )
+
+
+@dataclass(frozen=True)
+class ViewSettings:
+    """The viewpoint settings of :class:`planner.options.Options` (deg, m)."""
+
+    standoff_m: float
+    roll_step_deg: float
+    tilt_deg: float
+    tilt_azimuths: int
+    fallback_tilt_deg: float
+
+
+def hole_viewpoints(arm: ArmLike, hole: HoleLike, s: ViewSettings) -> tuple[HoleCandidates, bool]:
+    """:func:`hole_candidates` of ``hole``; when it has none and the fallback cone is wider,
+    those of the fallback cone if any. Returns them and whether the fallback gave them."""
+    c = hole_candidates(arm, hole, s.standoff_m, s.roll_step_deg, s.tilt_deg, s.tilt_azimuths)
+    if not c.ok and s.fallback_tilt_deg > s.tilt_deg:
+        # the first poses of both cones (the view along the axis) gave no candidate
+        axis = len(c.poses) // (1 + (s.tilt_azimuths if s.tilt_deg > 0 else 0))
+        tilted = hole_candidates(
+            arm, hole, s.standoff_m, s.roll_step_deg, s.fallback_tilt_deg, s.tilt_azimuths, axis
+        )
+        if tilted.ok:
+            return tilted, True
+    return c, False
+
+
+#: holes per chunk of work handed to the helper process (:mod:`planner.helper`)
+CHUNK = 6
+
+
+@dataclass
+class _Hole:
+    """What a hole's viewpoints need of it (sent to the helper process)."""
+
+    id: str
+    position_m: NDArray[np.float64]
+    normal: NDArray[np.float64]
+
+
+def _chunk_here(
+    arm: ArmLike, holes: list[HoleLike], s: ViewSettings
+) -> list[tuple[HoleCandidates, bool]]:
+    return [hole_viewpoints(arm, h, s) for h in holes]
+
+
+def _helper_chunk(holes: list[_Hole], s: ViewSettings) -> list[tuple[HoleCandidates, bool]]:
+    """:func:`hole_viewpoints` of ``holes`` (in the helper process)."""
+    return [hole_viewpoints(helper_arm(), h, s) for h in holes]
+
+
+def all_hole_candidates(
+    arm: ArmLike,
+    holes: list[HoleLike],
+    s: ViewSettings,
+    helper: Helper | None = None,
+    progress: Callable[[int], None] | None = None,
+    meanwhile: Callable[[], None] | None = None,
+) -> list[tuple[HoleCandidates, bool]]:
+    """:func:`hole_viewpoints` of every hole, in order. With a ``helper``, it takes chunks
+    of ``CHUNK`` holes from the back while this process works from the front; a chunk it
+    has not started when this process reaches it is done here (the same results, whoever
+    computes them). ``progress(done)`` after each hole; ``meanwhile()``: other work for
+    this process, done first when there is a helper (which then takes more chunks)."""
+    out: list[tuple[HoleCandidates, bool] | None] = [None] * len(holes)
+    done = 0
+    chunks = [(lo, min(lo + CHUNK, len(holes))) for lo in range(0, len(holes), CHUNK)]
+    futures: dict[int, Future[list[tuple[HoleCandidates, bool]]]] = {}
+    if helper is not None:
+        for k in range(len(chunks) - 1, 0, -1):  # last chunk first; the first stays here
+            lo, hi = chunks[k]
+            sent = [
+                _Hole(h.id, np.asarray(h.position_m), np.asarray(h.normal)) for h in holes[lo:hi]
+            ]
+            futures[k] = helper.submit(_helper_chunk, sent, s)
+        if meanwhile is not None:
+            meanwhile()
+    for k, (lo, hi) in enumerate(chunks):
+        f = futures.get(k)
+        if f is not None and not f.cancel():
+            break  # the helper has it (and every chunk after it)
+        for i in range(lo, hi):
+            out[i] = hole_viewpoints(arm, holes[i], s)
+            done += 1
+            if progress is not None:
+                progress(done)
+    for k, f in futures.items():
+        if not f.cancelled():
+            lo, hi = chunks[k]
+            here = partial(_chunk_here, arm, holes[lo:hi], s)
+            out[lo:hi] = Helper.result(f, here)
+            done += hi - lo
+            if progress is not None:
+                progress(done)
+    assert all(x is not None for x in out)
+    return [x for x in out if x is not None]

@@ -1,0 +1,91 @@
+"""The helper process (planner.helper): the same viewpoints and motion checks with it as
+without it, whichever process computed what."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cell.config import load_cell
+from planner.edge_check import HELPER_MIN_MOTIONS, BatchEdgeChecker
+from planner.helper import MIN_HOLES, Helper
+from planner.paths import MotionChecker
+from planner.viewpoints import CHUNK, ViewSettings, all_hole_candidates
+
+pytestmark = pytest.mark.skipif(
+    not Helper.can_pay(MIN_HOLES), reason="no second core or no fork on this machine"
+)
+
+
+@pytest.fixture(scope="module")
+def cell():
+    return load_cell(None)
+
+
+def test_viewpoints_with_a_helper_equal_those_without(cell) -> None:
+    arm = cell.build_arm()
+    holes = cell.holes_in_cell()
+    assert len(holes) > 3 * CHUNK  # several chunks: both processes take some
+    s = ViewSettings(cell.tool.standoff_m, 30.0, 0.0, 6, 10.0)
+    want = all_hole_candidates(arm, holes, s)
+    seen: list[int] = []
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
+        got = all_hole_candidates(arm, holes, s, helper, seen.append)
+    assert seen[-1] == len(holes) and sorted(seen) == seen
+    assert len(got) == len(want)
+    for (c1, t1), (c2, t2) in zip(got, want, strict=True):
+        assert c1.hole_id == c2.hole_id and t1 == t2 and c1.reason == c2.reason
+        for name in ("q", "branch", "pose", "poses"):
+            assert np.array_equal(getattr(c1, name), getattr(c2, name))
+
+
+def test_motion_checks_split_with_a_helper_equal_one_process(cell) -> None:
+    arm = cell.build_arm()
+    checker = MotionChecker(arm, np.radians(3.0), 0.012)
+    rng = np.random.default_rng(5)
+    m = 2 * HELPER_MIN_MOTIONS + 40
+    A = rng.uniform(arm.lower, arm.upper, (m, 6)) * 0.4
+    B = np.clip(A + rng.normal(scale=0.3, size=A.shape), arm.lower, arm.upper)
+    B[:5] = arm.upper + 0.1  # outside the limits: not free
+    alone = BatchEdgeChecker(checker)
+    want = alone.free(A, B)
+    split = BatchEdgeChecker(checker)
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
+        got = split.free(A, B, helper)
+    assert got.tolist() == want.tolist()
+    assert split.checks == alone.checks
+    assert 0 < got.sum() < len(got) - 5  # both answers occur
+
+
+def test_representatives_chosen_with_a_helper_equal_those_without(cell) -> None:
+    from planner.representatives import every_representatives
+    from planner.timing import JointLimits
+
+    arm = cell.build_arm()
+    limits = JointLimits.from_arm(arm)
+    home = np.asarray(cell.home_q(), float)
+    rng = np.random.default_rng(6)
+    cands = [rng.uniform(arm.lower, arm.upper, (m, 6)) for m in (3, 40, 8, 60, 5, 9, 30, 2, 50)]
+    want = every_representatives(cands, 8, home, limits)
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
+        got = every_representatives(cands, 8, home, limits, helper)
+    assert [g.tolist() for g in got] == [w.tolist() for w in want]
+    assert any(len(w) == 8 for w in want) and any(len(w) < 8 for w in want)
+
+
+def test_a_helper_that_died_leaves_its_share_to_this_process(cell) -> None:
+    import os
+    import signal
+
+    arm = cell.build_arm()
+    holes = cell.holes_in_cell()[: 2 * CHUNK + 1]
+    s = ViewSettings(cell.tool.standoff_m, 60.0, 0.0, 6, 10.0)
+    want = all_hole_candidates(arm, holes, s)
+    helper = Helper.start(MIN_HOLES, arm=arm)
+    for pid in list(helper.pool._processes):
+        os.kill(pid, signal.SIGKILL)
+    got = all_hole_candidates(arm, holes, s, helper)
+    assert helper.close() == 0.0
+    assert [np.array_equal(a.q, b.q) for (a, _), (b, _) in zip(got, want, strict=True)] == [
+        True
+    ] * len(holes)
