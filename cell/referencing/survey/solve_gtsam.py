@@ -43,6 +43,9 @@ SKEW_SIGMA = 1e-6
 _H = 1e-7
 
 
+#: the Huber loss's corner of the robust first adjustment (sigma)
+HUBER_K = 3.0
+
 #: an adjustment that made no step and whose variance factor is above this is refused
 STUCK_VARIANCE_FACTOR = 100.0
 
@@ -97,11 +100,13 @@ def _priors(graph: gtsam.NonlinearFactorGraph, problem: SurveyProblem) -> None:
 
 
 def _graph(
-    problem: SurveyProblem, tie_sigma: float = RIG_TIE_SIGMA
+    problem: SurveyProblem, tie_sigma: float = RIG_TIE_SIGMA, robust: bool = False
 ) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Values]:
     graph = gtsam.NonlinearFactorGraph()
     values = gtsam.Values()
     pix = gtsam.noiseModel.Isotropic.Sigma(2, problem.sigma_px)
+    if robust:
+        pix = gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Huber.Create(HUBER_K), pix)
     for k in range(len(problem.uv)):
         v, j, s = int(problem.view[k]), int(problem.marker[k]), int(problem.side[k])
         pose = X(v) if s == 0 else Y(v)
@@ -121,11 +126,15 @@ def _graph(
     return graph, values
 
 
-def solve_gtsam(problem: SurveyProblem, covariance: bool = True) -> RawSolution:
+def solve_gtsam(
+    problem: SurveyProblem, covariance: bool = True, robust: bool = False
+) -> RawSolution:
     """Adjust ``problem`` (module doc); ``covariance``: also the markers' joint covariance
     (3n, 3n) m² and the head's, stated at the a posteriori centre noise, not below the floor
-    (:mod:`cell.referencing.sigma`)."""
-    graph, values = _graph(problem)
+    (:mod:`cell.referencing.sigma`); ``robust``: the image residuals through a Huber loss
+    (:data:`HUBER_K` sigma), so that a gross error (a misread marker, a view far off its
+    plan) cannot pull the self-calibrated head with it before it is found."""
+    graph, values = _graph(problem, robust=robust)
     params = gtsam.LevenbergMarquardtParams()
     params.setRelativeErrorTol(1e-10)
     params.setAbsoluteErrorTol(1e-10)
