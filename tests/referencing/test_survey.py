@@ -111,6 +111,20 @@ def test_an_outlier_is_named_dropped_and_the_rest_holds(small_cell, stereo, mark
     assert any("P002" in w and "dropped" in w for w in res.warnings)
 
 
+def test_a_marker_misread_far_off_is_found_without_bending_the_head(small_cell, stereo,
+                                                                     marker_truth):  # fmt: skip
+    """A code read on the wrong marker (hundreds of pixels off, as in a demo survey): the robust
+    first round keeps it from dragging the self-calibrated head, so it alone is dropped."""
+    views = survey_observations(small_cell, stereo, marker_truth)
+    v = next(v for v in views if "P002" in v.uv_right)
+    v.uv_right["P002"] = v.uv_right["P002"] + np.array([640.0, -450.0])
+    res = survey(small_cell, stereo, views)
+    assert [(o[0], o[1], o[2]) for o in res.outliers] == [(v.view_id, "P002", "right")]
+    rows = [marker_truth.ids.index(m) for m in res.marker_ids]
+    e = _rigid_error(res.positions_cell, marker_truth.true[rows])
+    assert np.sqrt(np.mean(e**2)) < 10e-6
+
+
 def test_without_scale_bars_the_survey_says_its_scale_uncertainty(stereo, marker_truth):
     cell = parse_cell(small_cell_text(bars=False), "nobars.yaml", builtin_cell_path())
     truth = draw_marker_truth(cell, seed=3)
