@@ -162,3 +162,29 @@ def test_reference_target_renders_and_measures():
     r = render_reference_pair(st, c, n, 0.010, seed=2)
     m = measure_hole(r.left, r.right, st, expected_diameter_m=0.010)
     assert abs(m.radius_m - 0.005) < 3e-6 and np.linalg.norm(m.center_m - c) < 10e-6
+
+
+def test_circle_lm_reaches_the_minimum_scipy_finds():
+    """The hand-written LM of the orthogonal cost against scipy's MINPACK LM on the same
+    residuals (numerical Jacobian), from the same rough start."""
+    from scipy.optimize import least_squares
+
+    from measure.circle import _basis, _residuals, _unpack, initial_circle
+
+    rng = np.random.default_rng(7)
+    for noise in (1e-6, 20e-6):
+        p, c, n, r, _ = _circle_points(300, noise, rng)
+        w = rng.uniform(0.5, 1.0, len(p))
+        ours = fit_circle_3d(p, w, robust=False)
+        c0, n0, r0 = initial_circle(p, w)
+        u, v = _basis(n0)
+        x0 = np.concatenate([c0 * 1e3, [0.0, 0.0, r0 * 1e3]])
+        args = (p * 1e3, np.sqrt(w), n0, u, v, "orthogonal")
+        sol = least_squares(_residuals, x0, args=args, method="lm", xtol=1e-14, ftol=1e-14)
+        cs, ns, rs = _unpack(sol.x, n0, u, v)
+        assert np.linalg.norm(ours.center - cs / 1e3) < 1e-9
+        assert abs(ours.radius - rs / 1e3) < 1e-9
+        assert abs(ours.normal @ ns) > np.cos(1e-6)
+        mine = orthogonal_distance(p, ours.center, ours.normal, ours.radius)
+        theirs = orthogonal_distance(p, cs / 1e3, ns, rs / 1e3)
+        assert np.sum(w * mine**2) <= np.sum(w * theirs**2) * (1 + 1e-9)
