@@ -24,6 +24,7 @@ bites) in :mod:`measure.outline`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -111,30 +112,31 @@ def _discs(
     contours, _ = cv2.findContours(mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     min_len = max(8, int(2.0 * np.sqrt(np.pi * min_area)))  # 2√(π A) ≈ the disc's perimeter
     out = []
-    for c in contours:
-        if len(c) < min_len:
-            continue
+    lengths = np.fromiter(map(len, contours), dtype=np.intp, count=len(contours))
+    for i in np.flatnonzero(lengths >= min_len):
+        c = contours[i]
         x, y, w, h = cv2.boundingRect(c)
         if w * h < min_area:
-            continue
-        m = cv2.moments(c)
-        area = m["m00"]
-        if area < min_area or area > 0.5 * H * W:
             continue
         border = x == 0 or y == 0 or x + w == W or y + h == H
         if border != border_only:
             continue
+        area = cv2.contourArea(c)  # = the moments' m00 (integer vertices: exact)
+        if area < min_area or area > 0.5 * H * W:
+            continue
         if not border and (
             area < 0.5 * w * h
             or min(w, h) < 0.3 * max(w, h)
-            or 4.0 * np.pi * area < 0.45 * len(c) ** 2  # ragged: a disc's is about 0.8
+            or 4.0 * math.pi * area < 0.45 * len(c) ** 2  # ragged: a disc's is about 0.8
         ):
             continue
         if reach(x, y, w, h) < 0.5:
             continue
         if tally is not None:
             tally[0] += 1
-        if disc_like(c.reshape(-1, 2).astype(np.float64), (H, W), border):
+        if disc_like(c.reshape(-1, 2), (H, W), border):
+            m = cv2.moments(c)
+            area = m["m00"]
             out.append((m["m10"] / area, m["m01"] / area, area, (x, y, w, h), border, level))
             continue
         rest = None if border else without_bites(c)
@@ -198,6 +200,14 @@ def _group(discs: list[tuple]) -> list[tuple]:
         & (dist < np.sqrt(area / np.pi)[None, :])
     )
     return [p for p, nested in zip(picks, inside.any(axis=1), strict=True) if not nested]
+
+
+def _threshold(img: np.ndarray, thr: float, below: bool) -> np.ndarray:
+    """``img <= thr`` (``below``) or ``img > thr`` as a 0/1 ``uint8`` mask of a ``uint8``
+    image: one ``cv2.threshold`` at ⌊thr⌋ (for integer pixels the same test), several times
+    faster than NumPy's comparison with a float."""
+    kind = cv2.THRESH_BINARY_INV if below else cv2.THRESH_BINARY
+    return cv2.threshold(img, math.floor(thr), 1, kind)[1]
 
 
 def _reach(small: np.ndarray, polarity: str, thr: float, extreme: float):
@@ -275,7 +285,7 @@ def find_candidates(
         for polarity, thresholds, extreme in _levels((p_lo, p_med, p_hi)):
             discs = []
             for k, thr in enumerate(thresholds):
-                mask = (small <= thr) if polarity == "dark" else (small > thr)
+                mask = _threshold(small, thr, polarity == "dark")
                 reach = _reach(small, polarity, thr, extreme)
                 discs += _discs(mask, min_area, k, border_only, reach, tally)
             found[polarity] = (thresholds, _group(discs))

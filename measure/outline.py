@@ -3,6 +3,8 @@ the outline without the concave bites something inside the bore takes out of it.
 
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
 
@@ -37,20 +39,30 @@ def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray 
 
 
 def disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
-    """Does the outline (N, 2) (away from the image border) follow an ellipse?"""
+    """Does the outline (N, 2) (away from the image border) follow an ellipse?
+
+    ``pts`` may be float or OpenCV's int32 contour points (then used as they are)."""
+    pts = pts.reshape(-1, 2)
     if border:
         H, W = shape
         keep = (pts[:, 0] > 0) & (pts[:, 1] > 0) & (pts[:, 0] < W - 1) & (pts[:, 1] < H - 1)
         pts = pts[keep]
-    if len(pts) < 12:
+    n = len(pts)
+    if n < 12:
         return False
-    (cx, cy), (a2, b2), ang = cv2.fitEllipse(pts.astype(np.float32))
-    if not np.isfinite(a2 + b2) or min(a2, b2) <= 2 or min(a2, b2) / max(a2, b2) < 0.35:
+    ell_pts = pts if pts.dtype in (np.int32, np.float32) else pts.astype(np.float32)
+    (cx, cy), (a2, b2), ang = cv2.fitEllipse(ell_pts)
+    if not math.isfinite(a2 + b2) or min(a2, b2) <= 2 or min(a2, b2) / max(a2, b2) < 0.35:
         return False
-    t = np.deg2rad(ang)
-    d = pts - (cx, cy)
-    u = d[:, 0] * np.cos(t) + d[:, 1] * np.sin(t)
-    v = -d[:, 0] * np.sin(t) + d[:, 1] * np.cos(t)
-    rel = np.abs(np.hypot(u / (a2 / 2), v / (b2 / 2)) - 1.0)
+    t = math.radians(ang)
+    c, s = math.cos(t), math.sin(t)
+    dx = pts[:, 0] - cx
+    dy = pts[:, 1] - cy
+    u = (dx * c + dy * s) * (2.0 / a2)
+    v = (dy * c - dx * s) * (2.0 / b2)
+    rel = np.abs(np.sqrt(u * u + v * v) - 1.0)
     tol = max(0.06, 1.5 / (0.5 * min(a2, b2)))
-    return float(np.median(rel)) < tol / 2 and float(np.mean(rel < tol)) > 0.6
+    k = n // 2  # the median as np.median takes it, from one partial sort
+    part = np.partition(rel, [k - 1, k] if n % 2 == 0 else [k])
+    median = 0.5 * (part[k - 1] + part[k]) if n % 2 == 0 else part[k]
+    return float(median) < tol / 2 and np.count_nonzero(rel < tol) > 0.6 * n
