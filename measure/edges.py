@@ -64,18 +64,23 @@ class EdgePoints:
 
 
 def _median(img: np.ndarray, mask: np.ndarray, full: float) -> float | None:
-    """Median gray level (fraction of full scale) of the masked pixels, from a histogram."""
-    if not mask.any():
-        return None
+    """Median gray level (fraction of full scale) of the masked pixels (a nonzero ``uint8``
+    or bool mask), from a histogram; ``None`` when no pixel is masked."""
     bins = 256 if img.dtype == np.uint8 else 1024
     hist = cv2.calcHist([img], [0], mask.view(np.uint8), [bins], [0, full + 1]).ravel()
     cdf = np.cumsum(hist)
+    if cdf[-1] <= 0:
+        return None
     k = int(np.searchsorted(cdf, 0.5 * cdf[-1]))
     return (k + 0.5) * (full + 1) / bins / full
 
 
-def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
-    """The filled outer outline of the mask component around ``seed`` (ROI pixels).
+Box = tuple[int, int, int, int]
+
+
+def _region(mask: np.ndarray, seed: tuple[float, float]) -> tuple[np.ndarray, Box | None]:
+    """The filled outer outline of the mask component around ``seed`` (ROI pixels), and
+    its bounding box (x, y, w, h; ``None`` when there is no component).
 
     Islands inside the hole (a screw) do not matter; a bite into the outline (a screw
     head touching the rim in the image) is bridged by the ellipse through the rest.
@@ -85,9 +90,10 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
     pool = inside or list(contours)
     region = np.zeros(mask.shape, np.uint8)
     if not pool:
-        return region
+        return region, None
     c = max(pool, key=cv2.contourArea)
     cv2.drawContours(region, [c], -1, 1, thickness=cv2.FILLED)
+    box = cv2.boundingRect(c)
     area = cv2.contourArea(c)
     hull_area = cv2.contourArea(cv2.convexHull(c))
     if len(c) >= 24 and area < 0.97 * hull_area:
@@ -96,12 +102,48 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
             ell = cv2.fitEllipse(rest.astype(np.float32))
             if np.all(np.isfinite(ell[1])) and min(ell[1]) > 2:
                 cv2.ellipse(region, ell, 1, thickness=cv2.FILLED)
-    return region
+                box = cv2.boundingRect(region)
+    return region, box
+
+
+def _f32_above(x: float) -> np.float32:
+    """The smallest float32 greater than ``x``."""
+    f = np.float32(x)
+    return f if float(f) > x else np.nextafter(f, np.float32(np.inf))
+
+
+def _f32_at_most(x: float) -> np.float32:
+    """The largest float32 not above ``x``."""
+    f = np.float32(x)
+    return f if float(f) <= x else np.nextafter(f, np.float32(-np.inf))
 
 
 def _ring(outside_px: np.ndarray, inner: float, outer: float) -> np.ndarray:
-    """Pixels between ``inner`` and ``outer`` px outside the region (from its distance map)."""
-    return (outside_px > inner) & (outside_px <= outer)
+    """Pixels between ``inner`` (exclusive) and ``outer`` px outside the region, from its
+    float32 distance map, as a 0/255 ``uint8`` mask (one ``cv2.inRange`` pass)."""
+    return cv2.inRange(outside_px, float(_f32_above(inner)), float(_f32_at_most(outer)))
+
+
+def _below(img: np.ndarray, level: float) -> np.ndarray:
+    """``img <= level`` as a 0/1 ``uint8`` mask (``cv2.threshold`` at ⌊level⌋ for 8-bit)."""
+    if img.dtype == np.uint8:
+        return cv2.threshold(img, float(np.floor(level)), 1, cv2.THRESH_BINARY_INV)[1]
+    return (img <= level).view(np.uint8)
+
+
+def _above(img: np.ndarray, level: float) -> np.ndarray:
+    """``img > level`` as a 0/1 ``uint8`` mask."""
+    if img.dtype == np.uint8:
+        return cv2.threshold(img, float(np.floor(level)), 1, cv2.THRESH_BINARY)[1]
+    return (img > level).view(np.uint8)
+
+
+def _grow(box: Box, pad: int, shape: tuple[int, int]) -> tuple[slice, slice, int, int]:
+    """Row and column slices of ``box`` grown by ``pad`` px (clipped), and their origin."""
+    x, y, w, h = box
+    x0, y0 = max(x - pad, 0), max(y - pad, 0)
+    x1, y1 = min(x + w + pad, shape[1]), min(y + h + pad, shape[0])
+    return slice(y0, y1), slice(x0, x1), x0, y0
 
 
 def hole_region(
@@ -115,14 +157,15 @@ def hole_region(
     rim where the light is uneven, and lies on the middle of a soft edge. For a bright
     interior (a through-hole against a lit background) pixels as far *below* the
     surrounding level are part of the hole too: the bore wall, seen at a tilt as a dark
-    crescent between the background and the rim.
+    crescent between the background and the rim. Masks, erosion, the inner ring and the
+    moments are worked out on the region's box (plus what they reach), not the whole crop.
     """
     H, W = img.shape
     x, y, w, h = cand.bbox
     m = margin_px + int(0.12 * max(w, h))
     x0, y0 = max(x - m, 0), max(y - m, 0)
     x1, y1 = min(x + w + m, W), min(y + h + m, H)
-    roi_img = np.ascontiguousarray(img[y0:y1, x0:x1])
+    roi_img = img[y0:y1, x0:x1]
     cx, cy = cand.centroid_px
     seed = (float(cx - x0), float(cy - y0))
     box = (x0, y0, x1 - x0, y1 - y0)
@@ -130,41 +173,47 @@ def hole_region(
     level = cand.threshold
     surf = cand.surface_level
     if dark:
-        first = roi_img <= level * full
+        first = _below(roi_img, level * full)
     elif surf is None or level <= surf:
-        first = roi_img > level * full
+        first = _above(roi_img, level * full)
     else:  # the lit background and the wall crescent beside it (measure.opening)
-        first = (roi_img > level * full) | (roi_img < (2 * surf - level) * full)
-    region = _region(first, seed)
+        first = _above(roi_img, level * full) | (roi_img < (2 * surf - level) * full)
+    region, rbox = _region(first, seed)
     inside = outside = level
     dist = None
-    if region.any():
+    if rbox is not None:
         k = max(4, int(0.03 * cand.diameter_px))
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
-        core = cv2.erode(region, ker) > 0
-        dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)  # px outside the region
-        lout = _median(roi_img, _ring(dist, 3, 3 + k), full)
+        ys, xs, _, _ = _grow(rbox, 3, region.shape)  # the kernel's reach: zeros round the box
+        core = np.zeros(region.shape, np.uint8)
+        core[ys, xs] = cv2.erode(region[ys, xs], ker)
+        dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
+        ys, xs, _, _ = _grow(rbox, 5 + 2 * k, region.shape)  # holds the ring 3 … 3 + k px
+        lout = _median(roi_img[ys, xs], _ring(dist[ys, xs], 3, 3 + k), full)
         if not dark and lout is not None:  # the lit part only, not the wall crescent
-            core &= roi_img > lout * full
+            core &= _above(roi_img, lout * full)
         lin = _median(roi_img, core, full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
             if dark:
-                mask = roi_img <= level * full
+                mask = _below(roi_img, level * full)
             else:  # a lit background: the bore wall seen at a tilt is a dark crescent
-                mask = (roi_img > level * full) | (roi_img < (2 * lout - level) * full)
-            refined = _region(mask, seed)
-            ratio = float(refined.sum()) / float(region.sum())
+                mask = _above(roi_img, level * full) | (roi_img < (2 * lout - level) * full)
+            refined, fbox = _region(mask, seed)
+            ratio = float(cv2.countNonZero(refined)) / float(cv2.countNonZero(region))
             if 0.6 < ratio < 1.6:  # the same region, better placed; else keep the first
-                region = refined  # (moved by a pixel or two: the first distance map serves)
-    mom = cv2.moments(region, binaryImage=True)
+                region, rbox = refined, fbox  # (moved by a pixel or two: the first distance map serves)
+    if rbox is None:
+        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
+    bx, by = rbox[:2]
+    mom = cv2.moments(region[by : by + rbox[3], bx : bx + rbox[2]], binaryImage=True)
     if mom["m00"] <= 0:
         return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
-    centroid = (mom["m10"] / mom["m00"] + x0, mom["m01"] / mom["m00"] + y0)
+    centroid = (mom["m10"] / mom["m00"] + bx + x0, mom["m01"] / mom["m00"] + by + y0)
     d = 2.0 * np.sqrt(mom["m00"] / np.pi)
     if dist is None:
-        dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)
+        dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
     wide = _median(roi_img, _ring(dist, 0.05 * d, 0.2 * d), full)
     return HoleRegion(
         box,
@@ -176,6 +225,27 @@ def hole_region(
         outside,
         outside if wide is None else wide,
     )
+
+
+def _percentile(a: np.ndarray, q: float) -> float:
+    """``np.percentile(a, q)`` (linear interpolation; equal to NumPy's to the last bit of
+    ``a``'s precision) from one partial sort, without NumPy's generic bookkeeping; ``a``
+    is 1-D and not empty."""
+    n = len(a)
+    pos = q / 100.0 * (n - 1)
+    lo = int(np.floor(pos))
+    hi = min(lo + 1, n - 1)
+    part = np.partition(a, [lo, hi] if hi > lo else [lo])
+    b0, b1, t = float(part[lo]), float(part[hi]), pos - lo
+    d = b1 - b0
+    return float(a.dtype.type(b1 - d * (1.0 - t) if t >= 0.5 else b0 + d * t))
+
+
+def _band(region: np.ndarray, half_width: int) -> np.ndarray:
+    """:func:`outline_band` as a 0/1 ``uint8`` mask."""
+    u8 = region.view(np.uint8)
+    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * half_width + 1, 2 * half_width + 1))
+    return cv2.subtract(cv2.dilate(u8, k), cv2.erode(u8, k))
 
 
 def outline_band(region: np.ndarray, half_width: int) -> np.ndarray:
@@ -246,11 +316,11 @@ def subpixel_edges(
     gx = cv2.sepFilter2D(sub, cv2.CV_32F, kd, ks)
     gy = cv2.sepFilter2D(sub, cv2.CV_32F, ks, kd)
     mag = cv2.magnitude(gx, gy)
-    band = outline_band(region.mask[cy0:cy1, cx0:cx1], 3)
-    vals = mag[band]
+    band = _band(region.mask[cy0:cy1, cx0:cx1], 3)  # 0/1
+    vals = mag[band.view(bool)]
     if len(vals) == 0:
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
-    peak = float(np.percentile(vals, 98))
+    peak = _percentile(vals, 98.0)
     if peak <= 0:
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
     scale = np.float32(16000.0 / max(float(mag.max()), 1e-12))  # |g| ≤ max: no clipping
@@ -258,7 +328,11 @@ def subpixel_edges(
     dy = (gy * scale).astype(np.int16)
     hi = 0.35 * peak * float(scale)
     edges = cv2.Canny(dx, dy, 0.5 * hi, hi, L2gradient=True)
-    ys, xs = np.nonzero(edges & band)
+    found = cv2.findNonZero(cv2.bitwise_and(edges, band))  # row by row, as np.nonzero
+    if found is None:
+        return EdgePoints(np.zeros((0, 2)), np.zeros(0))
+    found = found.reshape(-1, 2).astype(np.intp)
+    xs, ys = found[:, 0], found[:, 1]
     keep = (xs >= 3) & (ys >= 3) & (xs < w - 3) & (ys < h - 3)
     xs, ys = xs[keep], ys[keep]
     horiz = np.abs(gx[ys, xs]) >= np.abs(gy[ys, xs])
@@ -272,7 +346,7 @@ def subpixel_edges(
     xs, ys = xs[ok], ys[ok]
     widths = _edge_widths(mag, gx, gy, xs, ys, sx[ok], sy[ok])
     finite = widths[np.isfinite(widths)]
-    blur = float(np.median(finite)) if len(finite) else 0.0
+    blur = _percentile(finite, 50.0) if len(finite) else 0.0
     strength = mag[ys, xs].astype(np.float64)
     if slope_correction and method == "parabola" and len(pts):
         normals = np.stack([gx[ys, xs], gy[ys, xs]], axis=1) / np.maximum(strength, 1e-12)[:, None]
