@@ -202,8 +202,10 @@ def hole_region(
                 mask = _above(roi_img, level * full) | (roi_img < (2 * lout - level) * full)
             refined, fbox = _region(mask, seed)
             ratio = float(cv2.countNonZero(refined)) / float(cv2.countNonZero(region))
-            if 0.6 < ratio < 1.6:  # the same region, better placed; else keep the first
-                region, rbox = refined, fbox  # (moved by a pixel or two: the first distance map serves)
+            # the same region, better placed; else keep the first (moved by a pixel or two:
+            # the first distance map serves)
+            if 0.6 < ratio < 1.6:
+                region, rbox = refined, fbox
     if rbox is None:
         return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
     bx, by = rbox[:2]
@@ -266,7 +268,7 @@ def gradient_kernels(sigma_px: float, full: float) -> tuple[np.ndarray, np.ndarr
     rounding, away from the border.
     """
     if sigma_px > 0:
-        k = int(round(sigma_px * 8 + 1)) | 1
+        k = round(sigma_px * 8 + 1) | 1
         g = cv2.getGaussianKernel(k, sigma_px, cv2.CV_32F).ravel().astype(np.float64)
     else:
         g = np.ones(1)

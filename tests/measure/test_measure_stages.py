@@ -173,7 +173,7 @@ def test_circle_lm_reaches_the_minimum_scipy_finds():
 
     rng = np.random.default_rng(7)
     for noise in (1e-6, 20e-6):
-        p, c, n, r, _ = _circle_points(300, noise, rng)
+        p, *_ = _circle_points(300, noise, rng)
         w = rng.uniform(0.5, 1.0, len(p))
         ours = fit_circle_3d(p, w, robust=False)
         c0, n0, r0 = initial_circle(p, w)
