@@ -118,21 +118,27 @@ def initial_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def algebraic_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    """Algebraic circle: the least-squares plane (as :func:`initial_circle`), then the
-    Kåsa circle of the points projected into it (a linear solve of
-    x² + y² = 2 a x + 2 b y + k). Near the optimum for a closed contour, so the LM
-    started from it converges in an iteration or two."""
-    c0 = (pts * w[:, None]).sum(axis=0) / w.sum()
-    sw = np.sqrt(w)
-    _, _, vt = np.linalg.svd((pts - c0) * sw[:, None], full_matrices=False)
+    """Algebraic circle: the least-squares plane (as :func:`initial_circle`, here from the
+    eigenvectors of the 3 × 3 weighted scatter matrix), then the Kåsa circle of the points
+    projected into it (a linear solve of x² + y² = 2 a x + 2 b y + k, by its 3 × 3 normal
+    equations). Near the optimum for a closed contour, so the LM started from it
+    converges in an iteration or two."""
+    c0 = (w @ pts) / w.sum()
     d = pts - c0
-    x, y = d @ vt[0], d @ vt[1]
-    A = np.stack([2.0 * x, 2.0 * y, np.ones_like(x)], axis=1) * sw[:, None]
-    (a, b, k), *_ = np.linalg.lstsq(A, (x * x + y * y) * sw, rcond=None)
+    dw = d * w[:, None]
+    _, vecs = np.linalg.eigh(dw.T @ d)  # ascending: the normal is the last column but two
+    e0, e1, n = vecs[:, 2], vecs[:, 1], vecs[:, 0]
+    x, y = d @ e0, d @ e1
+    A = np.stack([2.0 * x, 2.0 * y, np.ones_like(x)], axis=1)
+    Aw = A * w[:, None]
+    try:
+        a, b, k = np.linalg.solve(Aw.T @ A, Aw.T @ (x * x + y * y))
+    except np.linalg.LinAlgError:
+        return initial_circle(pts, w)
     r2 = k + a * a + b * b
     if not (np.isfinite(r2) and r2 > 0):
         return initial_circle(pts, w)
-    return c0 + a * vt[0] + b * vt[1], vt[2], float(np.sqrt(r2))
+    return c0 + a * e0 + b * e1, n, float(np.sqrt(r2))
 
 
 def _orthogonal_system(pts, sw, c, n, r):
@@ -257,7 +263,16 @@ def _support(pts: np.ndarray, w: np.ndarray, c: np.ndarray, n: np.ndarray, r: fl
 
 def _sigma(d: np.ndarray, floor: float) -> float:
     """Robust σ of isotropic 2-D residuals from their distances (Rayleigh median)."""
-    return max(float(np.median(d)) / 1.1774, floor)
+    n = len(d)
+    k = n // 2
+    if n == 0:
+        return max(float("nan"), floor)  # as np.median of nothing
+    if n % 2:
+        med = float(np.partition(d, k)[k])
+    else:  # as np.median: the mean of the two middle values
+        part = np.partition(d, [k - 1, k])
+        med = 0.5 * float(part[k - 1] + part[k])
+    return max(med / 1.1774, floor)
 
 
 def fit_circle_3d(
