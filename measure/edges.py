@@ -337,21 +337,25 @@ def subpixel_edges(
     xs, ys = found[:, 0], found[:, 1]
     keep = (xs >= 3) & (ys >= 3) & (xs < w - 3) & (ys < h - 3)
     xs, ys = xs[keep], ys[keep]
-    horiz = np.abs(gx[ys, xs]) >= np.abs(gy[ys, xs])
-    sx, sy = horiz.astype(np.int64), (~horiz).astype(np.int64)
+    gxs, gys = gx[ys, xs], gy[ys, xs]
+    horiz = np.abs(gxs) >= np.abs(gys)
+    sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
+    # the gradient magnitude at each pixel and its two neighbours along the dominant axis
+    g0 = mag[ys, xs].astype(np.float64)
+    gm = mag[ys - sy, xs - sx].astype(np.float64)
+    gp = mag[ys + sy, xs + sx].astype(np.float64)
     if method == "parabola":
-        off, ok = _parabola(mag, xs, ys, sx, sy)
+        off, ok = _parabola(gm, g0, gp)
     else:
         raw = sub.astype(np.float32) * np.float32(1.0 / full)
         off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
     pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
-    xs, ys = xs[ok], ys[ok]
-    widths = _edge_widths(mag, gx, gy, xs, ys, sx[ok], sy[ok])
+    gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
+    widths = _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
     finite = widths[np.isfinite(widths)]
     blur = _percentile(finite, 50.0) if len(finite) else 0.0
-    strength = mag[ys, xs].astype(np.float64)
     if slope_correction and method == "parabola" and len(pts):
-        normals = np.stack([gx[ys, xs], gy[ys, xs]], axis=1) / np.maximum(strength, 1e-12)[:, None]
+        normals = np.stack([gxs, gys], axis=1) / np.maximum(strength, 1e-12)[:, None]
         centre = (region.centroid_px[0] - x0, region.centroid_px[1] - y0)
         shift = slope_shift(gx, gy, pts, normals, strength, blur, centre)
         pts -= shift[:, None] * normals
@@ -363,23 +367,21 @@ def subpixel_edges(
     )
 
 
-def _edge_widths(mag, gx, gy, xs, ys, sx, sy) -> np.ndarray:
-    """Gaussian width (px) of the gradient profile across the edge at each point (inf: none)."""
-    lg = [
-        np.log(np.maximum(mag[ys + k * sy, xs + k * sx].astype(np.float64), 1e-12))
-        for k in (-1, 0, 1)
-    ]
-    curv = lg[0] - 2.0 * lg[1] + lg[2]
-    g = np.maximum(np.hypot(gx[ys, xs], gy[ys, xs]).astype(np.float64), 1e-12)
-    along = np.where(sx == 1, np.abs(gx[ys, xs]), np.abs(gy[ys, xs])) / g
+def _edge_widths(gm, g0, gp, gxs, gys, horiz) -> np.ndarray:
+    """Gaussian width (px) of the gradient profile across the edge at each point (inf: none),
+    from the magnitudes before, at and after it along the dominant axis (float64) and the
+    gradient there (float32)."""
+    lg0 = np.log(np.maximum(g0, 1e-12))
+    curv = np.log(np.maximum(gm, 1e-12)) - 2.0 * lg0 + np.log(np.maximum(gp, 1e-12))
+    g = np.maximum(np.hypot(gxs, gys).astype(np.float64), 1e-12)
+    along = np.where(horiz, np.abs(gxs), np.abs(gys)) / g
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(curv < 0, np.sqrt(-1.0 / curv) * along, np.inf)
 
 
-def _parabola(mag, xs, ys, sx, sy) -> tuple[np.ndarray, np.ndarray]:
-    g0 = mag[ys, xs].astype(np.float64)
-    gm = mag[ys - sy, xs - sx].astype(np.float64)
-    gp = mag[ys + sy, xs + sx].astype(np.float64)
+def _parabola(gm, g0, gp) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex offset (px, along the dominant axis) of the parabola through the magnitudes
+    before, at and after each pixel, and where it is a maximum within half a pixel."""
     den = gm - 2.0 * g0 + gp
     ok = (den < 0) & (g0 >= gm) & (g0 >= gp)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -44,7 +44,10 @@ def _flanks(pts: np.ndarray) -> list[np.ndarray]:
 
 def _steep(pts: np.ndarray, min_sin: float) -> np.ndarray:
     """Samples whose contour tangent is steeper than ``asin(min_sin)`` to the rows."""
-    t = np.roll(pts, -1, axis=0) - np.roll(pts, 1, axis=0)
+    t = np.empty_like(pts)  # next minus previous sample, around the closed contour
+    t[1:-1] = pts[2:] - pts[:-2]
+    t[0] = pts[1] - pts[-1]
+    t[-1] = pts[0] - pts[-2]
     return np.abs(t[:, 1]) > min_sin * np.hypot(t[:, 0], t[:, 1])
 
 
