@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from measure.circle_kernels import orthogonal_distances, orthogonal_system
 from measure.errors import FitError
 
 CIRCLE_COSTS = ("orthogonal", "published")
@@ -102,10 +103,12 @@ def orthogonal_distance(
     pts: np.ndarray, center: np.ndarray, normal: np.ndarray, radius: float
 ) -> np.ndarray:
     """Distance (metres) of each point (N, 3) from the circle."""
-    d = pts - center
-    h = d @ normal
-    rho = np.sqrt(np.maximum(np.einsum("ij,ij->i", d, d) - h * h, 0.0))
-    return np.hypot(h, rho - radius)
+    return orthogonal_distances(
+        np.ascontiguousarray(pts, dtype=np.float64).reshape(-1, 3),
+        np.asarray(center, dtype=np.float64).reshape(3),
+        np.asarray(normal, dtype=np.float64).reshape(3),
+        float(radius),
+    )
 
 
 def initial_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -144,24 +147,12 @@ def algebraic_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.nda
 def _orthogonal_system(pts, sw, c, n, r):
     """Weighted residuals (h, ρ − r) of every point and their Jacobian with respect to
     (c, a, b, r), the normal moved to n + a u + b v (u, v ⊥ n) and renormalised, at a = b = 0;
-    returned as JᵀJ (6 × 6), Jᵀe (6) and eᵀe."""
+    returned as JᵀJ (6 × 6), Jᵀe (6) and eᵀe (one compiled pass:
+    :func:`measure.circle_kernels.orthogonal_system`), with u and v."""
     u, v = _basis(n)
-    d = pts - c
-    h = d @ n
-    q = d - h[:, None] * n
-    rho = np.maximum(np.sqrt(np.einsum("ij,ij->i", q, q)), 1e-300)
-    du, dv = d @ u, d @ v
-    eh, er = h * sw, (rho - r) * sw
-    Jh = np.empty((len(pts), 6))
-    Jh[:, :3] = -n
-    Jh[:, 3], Jh[:, 4], Jh[:, 5] = du, dv, 0.0
-    Jh *= sw[:, None]
-    s = sw / rho
-    Jr = np.empty((len(pts), 6))
-    Jr[:, :3] = q * -s[:, None]
-    Jr[:, 3], Jr[:, 4], Jr[:, 5] = -h * du * s, -h * dv * s, -sw
-    JtJ = Jh.T @ Jh + Jr.T @ Jr
-    return JtJ, Jh.T @ eh + Jr.T @ er, float(eh @ eh + er @ er), u, v
+    c, n = np.ascontiguousarray(c, np.float64), np.ascontiguousarray(n, np.float64)
+    A, g, ee = orthogonal_system(pts, sw, c, n, u, v, float(r))
+    return A, g, float(ee), u, v
 
 
 def _lm_orthogonal(pts, sw, c, n, r, max_iter: int = 30):

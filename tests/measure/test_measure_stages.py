@@ -188,3 +188,30 @@ def test_circle_lm_reaches_the_minimum_scipy_finds():
         mine = orthogonal_distance(p, ours.center, ours.normal, ours.radius)
         theirs = orthogonal_distance(p, cs / 1e3, ns, rs / 1e3)
         assert np.sum(w * mine**2) <= np.sum(w * theirs**2) * (1 + 1e-9)
+
+
+def test_circle_kernels_match_the_array_expressions():
+    from measure.circle import _basis
+    from measure.circle_kernels import orthogonal_system
+
+    rng = np.random.default_rng(11)
+    p, c, n, r, _ = _circle_points(200, 30e-6, rng)
+    p, c, r = p * 1e3, c * 1e3 + 0.01, r * 1e3 * 1.001  # mm, a little off the optimum
+    sw = np.sqrt(rng.uniform(0.2, 1.0, len(p)))
+    u, v = _basis(n)
+    A, g, ee = orthogonal_system(p, sw, c, n, u, v, r)
+    d = p - c
+    h = d @ n
+    q = d - np.outer(h, n)
+    rho = np.linalg.norm(q, axis=1)
+    e = np.concatenate([h * sw, (rho - r) * sw])
+    Jh = np.column_stack([np.tile(-n, (len(p), 1)), d @ u, d @ v, np.zeros(len(p))])
+    Jr = np.column_stack([-q / rho[:, None], -(h / rho) * (d @ u), -(h / rho) * (d @ v),
+                          -np.ones(len(p))])  # fmt: skip
+    J = np.vstack([Jh * sw[:, None], Jr * sw[:, None]])
+    np.testing.assert_allclose(A, J.T @ J, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(g, J.T @ e, rtol=1e-10, atol=1e-12)
+    assert ee == pytest.approx(e @ e, rel=1e-12)
+    np.testing.assert_allclose(
+        orthogonal_distance(p, c, n, r), np.hypot(h, rho - r), rtol=1e-12, atol=1e-12
+    )
