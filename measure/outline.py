@@ -7,6 +7,7 @@ import math
 
 import cv2
 import numpy as np
+from numba import njit
 
 
 def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray | None:
@@ -55,14 +56,25 @@ def disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
     if not math.isfinite(a2 + b2) or min(a2, b2) <= 2 or min(a2, b2) / max(a2, b2) < 0.35:
         return False
     t = math.radians(ang)
-    c, s = math.cos(t), math.sin(t)
-    dx = pts[:, 0] - cx
-    dy = pts[:, 1] - cy
-    u = (dx * c + dy * s) * (2.0 / a2)
-    v = (dy * c - dx * s) * (2.0 / b2)
-    rel = np.abs(np.sqrt(u * u + v * v) - 1.0)
     tol = max(0.06, 1.5 / (0.5 * min(a2, b2)))
-    k = n // 2  # the median as np.median takes it, from one partial sort
-    part = np.partition(rel, [k - 1, k] if n % 2 == 0 else [k])
-    median = 0.5 * (part[k - 1] + part[k]) if n % 2 == 0 else part[k]
-    return float(median) < tol / 2 and np.count_nonzero(rel < tol) > 0.6 * n
+    median, within = _ellipse_fit(pts, cx, cy, math.cos(t), math.sin(t), 2.0 / a2, 2.0 / b2, tol)
+    return median < tol / 2 and within > 0.6 * n
+
+
+@njit(cache=True)
+def _ellipse_fit(pts, cx, cy, c, s, ia, ib, tol):
+    """Median of |ρ − 1| (ρ: each point's normalised radius on the ellipse centred at
+    (cx, cy), axes at angle (c, s), inverse half axes ia, ib) and how many are below
+    ``tol``; one compiled pass instead of a dozen array operations (the disc test runs
+    ten times a pair)."""
+    n = pts.shape[0]
+    rel = np.empty(n)
+    within = 0
+    for i in range(n):
+        dx, dy = pts[i, 0] - cx, pts[i, 1] - cy
+        u = (dx * c + dy * s) * ia
+        v = (dy * c - dx * s) * ib
+        rel[i] = abs(np.sqrt(u * u + v * v) - 1.0)
+        if rel[i] < tol:
+            within += 1
+    return np.median(rel), within
