@@ -98,8 +98,13 @@ def _discs(
     border_only: bool,
     reach,
     tally: list[int] | None = None,
+    shape: tuple[int, int] | None = None,
+    offset: tuple[int, int] = (0, 0),
 ) -> list[tuple]:
     """Disc-like outer regions of a mask: (cx, cy, area, bbox, border, level) in search px.
+
+    ``mask`` may be a window of the search image's mask at ``offset`` (x, y) holding all
+    its set pixels, with ``shape`` the whole image's: the outlines are the same.
 
     Outlines shorter than the smallest disc's perimeter, or filling their box far less
     than an ellipse does (π/4), are passed over before the disc test. Regions touching
@@ -108,8 +113,10 @@ def _discs(
     image's extreme): a region must reach 0.5 — a hole's interior goes far past the
     threshold that outlines it, a texture speck or a shadow barely crosses it.
     """
-    H, W = mask.shape
-    contours, _ = cv2.findContours(mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    H, W = mask.shape if shape is None else shape
+    contours, _ = cv2.findContours(
+        mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE, offset=offset
+    )
     min_len = max(8, int(2.0 * np.sqrt(np.pi * min_area)))  # 2√(π A) ≈ the disc's perimeter
     out = []
     lengths = np.fromiter(map(len, contours), dtype=np.intp, count=len(contours))
@@ -284,10 +291,32 @@ def find_candidates(
     for border_only in (False, True):  # regions cut by the border only when nothing else
         for polarity, thresholds, extreme in _levels((p_lo, p_med, p_hi)):
             discs = []
+            below = polarity == "dark"
+            # the masks are nested: the last level but one holds every lower level's pixels,
+            # so those levels are thresholded and traced only in its box (texture specks
+            # usually join the mask at the last level only)
+            inner = _threshold(small, thresholds[-2], below)
+            x, y, w, h = cv2.boundingRect(inner)
+            x0, y0 = max(x - 1, 0), max(y - 1, 0)
+            win = (
+                slice(y0, min(y + h + 1, small.shape[0])),
+                slice(x0, min(x + w + 1, small.shape[1])),
+            )
             for k, thr in enumerate(thresholds):
-                mask = _threshold(small, thr, polarity == "dark")
                 reach = _reach(small, polarity, thr, extreme)
-                discs += _discs(mask, min_area, k, border_only, reach, tally)
+                if k == len(thresholds) - 1:
+                    discs += _discs(
+                        _threshold(small, thr, below), min_area, k, border_only, reach, tally
+                    )
+                elif w > 0 and h > 0:
+                    mask = (
+                        inner[win]
+                        if k == len(thresholds) - 2
+                        else _threshold(small[win], thr, below)
+                    )
+                    discs += _discs(
+                        mask, min_area, k, border_only, reach, tally, small.shape, (x0, y0)
+                    )
             found[polarity] = (thresholds, _group(discs))
         if any(holes for _, holes in found.values()):
             break
