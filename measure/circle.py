@@ -155,7 +155,7 @@ def _orthogonal_system(pts, sw, c, n, r):
     return A, g, float(ee), u, v
 
 
-def _lm_orthogonal(pts, sw, c, n, r, max_iter: int = 30):
+def _lm_orthogonal(pts, sw, c, n, r, max_iter: int = 100):
     """Levenberg–Marquardt on the orthogonal cost (points in any length unit).
 
     The normal is re-parametrised about the current estimate at every step, so each step
