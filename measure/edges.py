@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 
 from measure.detect import HoleCandidate
+from measure.masks import above, below, grow_box, ring_mask
 from measure.outline import without_bites
 from measure.slope import slope_shift
 
@@ -106,46 +107,6 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> tuple[np.ndarray, Bo
     return region, box
 
 
-def _f32_above(x: float) -> np.float32:
-    """The smallest float32 greater than ``x``."""
-    f = np.float32(x)
-    return f if float(f) > x else np.nextafter(f, np.float32(np.inf))
-
-
-def _f32_at_most(x: float) -> np.float32:
-    """The largest float32 not above ``x``."""
-    f = np.float32(x)
-    return f if float(f) <= x else np.nextafter(f, np.float32(-np.inf))
-
-
-def _ring(outside_px: np.ndarray, inner: float, outer: float) -> np.ndarray:
-    """Pixels between ``inner`` (exclusive) and ``outer`` px outside the region, from its
-    float32 distance map, as a 0/255 ``uint8`` mask (one ``cv2.inRange`` pass)."""
-    return cv2.inRange(outside_px, float(_f32_above(inner)), float(_f32_at_most(outer)))
-
-
-def _below(img: np.ndarray, level: float) -> np.ndarray:
-    """``img <= level`` as a 0/1 ``uint8`` mask (``cv2.threshold`` at ⌊level⌋ for 8-bit)."""
-    if img.dtype == np.uint8:
-        return cv2.threshold(img, float(np.floor(level)), 1, cv2.THRESH_BINARY_INV)[1]
-    return (img <= level).view(np.uint8)
-
-
-def _above(img: np.ndarray, level: float) -> np.ndarray:
-    """``img > level`` as a 0/1 ``uint8`` mask."""
-    if img.dtype == np.uint8:
-        return cv2.threshold(img, float(np.floor(level)), 1, cv2.THRESH_BINARY)[1]
-    return (img > level).view(np.uint8)
-
-
-def _grow(box: Box, pad: int, shape: tuple[int, int]) -> tuple[slice, slice, int, int]:
-    """Row and column slices of ``box`` grown by ``pad`` px (clipped), and their origin."""
-    x, y, w, h = box
-    x0, y0 = max(x - pad, 0), max(y - pad, 0)
-    x1, y1 = min(x + w + pad, shape[1]), min(y + h + pad, shape[0])
-    return slice(y0, y1), slice(x0, x1), x0, y0
-
-
 def hole_region(
     img: np.ndarray, full: float, cand: HoleCandidate, margin_px: int = 10
 ) -> HoleRegion:
@@ -173,33 +134,33 @@ def hole_region(
     level = cand.threshold
     surf = cand.surface_level
     if dark:
-        first = _below(roi_img, level * full)
+        first = below(roi_img, level * full)
     elif surf is None or level <= surf:
-        first = _above(roi_img, level * full)
+        first = above(roi_img, level * full)
     else:  # the lit background and the wall crescent beside it (measure.opening)
-        first = _above(roi_img, level * full) | (roi_img < (2 * surf - level) * full)
+        first = above(roi_img, level * full) | (roi_img < (2 * surf - level) * full)
     region, rbox = _region(first, seed)
     inside = outside = level
     dist = None
     if rbox is not None:
         k = max(4, int(0.03 * cand.diameter_px))
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
-        ys, xs, _, _ = _grow(rbox, 3, region.shape)  # the kernel's reach: zeros round the box
+        ys, xs, _, _ = grow_box(rbox, 3, region.shape)  # the kernel's reach: zeros round the box
         core = np.zeros(region.shape, np.uint8)
         core[ys, xs] = cv2.erode(region[ys, xs], ker)
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
-        ys, xs, _, _ = _grow(rbox, 5 + 2 * k, region.shape)  # holds the ring 3 … 3 + k px
-        lout = _median(roi_img[ys, xs], _ring(dist[ys, xs], 3, 3 + k), full)
+        ys, xs, _, _ = grow_box(rbox, 5 + 2 * k, region.shape)  # holds the ring 3 … 3 + k px
+        lout = _median(roi_img[ys, xs], ring_mask(dist[ys, xs], 3, 3 + k), full)
         if not dark and lout is not None:  # the lit part only, not the wall crescent
-            core &= _above(roi_img, lout * full)
+            core &= above(roi_img, lout * full)
         lin = _median(roi_img, core, full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
             if dark:
-                mask = _below(roi_img, level * full)
+                mask = below(roi_img, level * full)
             else:  # a lit background: the bore wall seen at a tilt is a dark crescent
-                mask = _above(roi_img, level * full) | (roi_img < (2 * lout - level) * full)
+                mask = above(roi_img, level * full) | (roi_img < (2 * lout - level) * full)
             refined, fbox = _region(mask, seed)
             ratio = float(cv2.countNonZero(refined)) / float(cv2.countNonZero(region))
             # the same region, better placed; else keep the first (moved by a pixel or two:
@@ -216,7 +177,7 @@ def hole_region(
     d = 2.0 * np.sqrt(mom["m00"] / np.pi)
     if dist is None:
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
-    wide = _median(roi_img, _ring(dist, 0.05 * d, 0.2 * d), full)
+    wide = _median(roi_img, ring_mask(dist, 0.05 * d, 0.2 * d), full)
     return HoleRegion(
         box,
         centroid,
