@@ -18,6 +18,13 @@ Two costs:
   so for millimetre holes the plane term dominates and the radius and centre are weighted
   arbitrarily; it is kept for the benchmark comparison.
 
+The orthogonal cost is minimised by a small Levenberg–Marquardt loop written out in NumPy
+(:func:`_lm_orthogonal`: six parameters, JᵀJ formed directly, the normal re-parametrised
+about the current estimate at each step); from the algebraic circle it takes one or two
+steps and about 0.1 ms per step for 1500 points, where ``scipy.optimize.least_squares``
+spends about 1 ms per call on its own bookkeeping. A test checks that both reach the same
+minimum. The published cost is solved with ``least_squares`` (numerical Jacobian).
+
 Robustness: if less than 90 % of the points lie within 0.5 % of the radius (at least 10 µm)
 of the (refined) start, a three-point RANSAC circle with more support replaces it, followed by
 two iteratively reweighted passes with Cauchy weights; then iterative rejection of points
@@ -33,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from measure.circle_kernels import orthogonal_distances, orthogonal_system
 from measure.errors import FitError
 
 CIRCLE_COSTS = ("orthogonal", "published")
@@ -64,10 +72,14 @@ class Circle3D:
 
 
 def _basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    ref = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    u = np.cross(n, ref)
-    u /= np.linalg.norm(u)
-    return u, np.cross(n, u)
+    """Two unit vectors u = n × ref / |…| and v = n × u completing the unit normal ``n``
+    (ref: the x axis, else the y axis); written out, ``np.cross`` costs 20 µs a call."""
+    x, y, z = float(n[0]), float(n[1]), float(n[2])
+    u = (0.0, z, -y) if abs(x) < 0.9 else (-z, 0.0, x)  # n × (1, 0, 0) or n × (0, 1, 0)
+    k = 1.0 / np.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+    u = (u[0] * k, u[1] * k, u[2] * k)
+    v = (y * u[2] - z * u[1], z * u[0] - x * u[2], x * u[1] - y * u[0])
+    return np.array(u), np.array(v)
 
 
 def _unpack(x: np.ndarray, n0: np.ndarray, u: np.ndarray, v: np.ndarray):
@@ -87,33 +99,16 @@ def _residuals(x, pts, sw, n0, u, v, cost):
     return (res * sw[:, None]).ravel()
 
 
-def _jacobian(x, pts, sw, n0, u, v, cost):
-    """Analytic Jacobian of the orthogonal residuals (h, ρ − r) per point."""
-    c, n, _ = _unpack(x, n0, u, v)
-    m = n0 + x[3] * u + x[4] * v
-    P = (np.eye(3) - np.outer(n, n)) / np.linalg.norm(m)
-    dn = np.stack([P @ u, P @ v], axis=1)  # (3, 2): ∂n/∂(a, b)
-    d = pts - c
-    h = d @ n
-    q = d - np.outer(h, n)
-    rho = np.maximum(np.linalg.norm(q, axis=1), 1e-300)
-    J = np.zeros((len(pts), 2, 6))
-    J[:, 0, :3] = -n
-    J[:, 0, 3:5] = d @ dn
-    J[:, 1, :3] = -q / rho[:, None]
-    J[:, 1, 3:5] = -(h / rho)[:, None] * (d @ dn)
-    J[:, 1, 5] = -1.0
-    return (J * sw[:, None, None]).reshape(-1, 6)
-
-
 def orthogonal_distance(
     pts: np.ndarray, center: np.ndarray, normal: np.ndarray, radius: float
 ) -> np.ndarray:
     """Distance (metres) of each point (N, 3) from the circle."""
-    d = pts - center
-    h = d @ normal
-    rho = np.linalg.norm(d - np.outer(h, normal), axis=1)
-    return np.hypot(h, rho - radius)
+    return orthogonal_distances(
+        np.ascontiguousarray(pts, dtype=np.float64).reshape(-1, 3),
+        np.asarray(center, dtype=np.float64).reshape(3),
+        np.asarray(normal, dtype=np.float64).reshape(3),
+        float(radius),
+    )
 
 
 def initial_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -126,35 +121,87 @@ def initial_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def algebraic_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    """Algebraic circle: the least-squares plane (as :func:`initial_circle`), then the
-    Kåsa circle of the points projected into it (a linear solve of
-    x² + y² = 2 a x + 2 b y + k). Near the optimum for a closed contour, so the LM
-    started from it converges in an iteration or two."""
-    c0 = (pts * w[:, None]).sum(axis=0) / w.sum()
-    sw = np.sqrt(w)
-    _, _, vt = np.linalg.svd((pts - c0) * sw[:, None], full_matrices=False)
+    """Algebraic circle: the least-squares plane (as :func:`initial_circle`, here from the
+    eigenvectors of the 3 × 3 weighted scatter matrix), then the Kåsa circle of the points
+    projected into it (a linear solve of x² + y² = 2 a x + 2 b y + k, by its 3 × 3 normal
+    equations). Near the optimum for a closed contour, so the LM started from it
+    converges in an iteration or two."""
+    c0 = (w @ pts) / w.sum()
     d = pts - c0
-    x, y = d @ vt[0], d @ vt[1]
-    A = np.stack([2.0 * x, 2.0 * y, np.ones_like(x)], axis=1) * sw[:, None]
-    (a, b, k), *_ = np.linalg.lstsq(A, (x * x + y * y) * sw, rcond=None)
+    dw = d * w[:, None]
+    _, vecs = np.linalg.eigh(dw.T @ d)  # ascending: the normal is the last column but two
+    e0, e1, n = vecs[:, 2], vecs[:, 1], vecs[:, 0]
+    x, y = d @ e0, d @ e1
+    A = np.stack([2.0 * x, 2.0 * y, np.ones_like(x)], axis=1)
+    Aw = A * w[:, None]
+    try:
+        a, b, k = np.linalg.solve(Aw.T @ A, Aw.T @ (x * x + y * y))
+    except np.linalg.LinAlgError:
+        return initial_circle(pts, w)
     r2 = k + a * a + b * b
     if not (np.isfinite(r2) and r2 > 0):
         return initial_circle(pts, w)
-    return c0 + a * vt[0] + b * vt[1], vt[2], float(np.sqrt(r2))
+    return c0 + a * e0 + b * e1, n, float(np.sqrt(r2))
+
+
+def _orthogonal_system(pts, sw, c, n, r):
+    """Weighted residuals (h, ρ − r) of every point and their Jacobian with respect to
+    (c, a, b, r), the normal moved to n + a u + b v (u, v ⊥ n) and renormalised, at a = b = 0;
+    returned as JᵀJ (6 × 6), Jᵀe (6) and eᵀe (one compiled pass:
+    :func:`measure.circle_kernels.orthogonal_system`), with u and v."""
+    u, v = _basis(n)
+    c, n = np.ascontiguousarray(c, np.float64), np.ascontiguousarray(n, np.float64)
+    A, g, ee = orthogonal_system(pts, sw, c, n, u, v, float(r))
+    return A, g, float(ee), u, v
+
+
+def _lm_orthogonal(pts, sw, c, n, r, max_iter: int = 100):
+    """Levenberg–Marquardt on the orthogonal cost (points in any length unit).
+
+    The normal is re-parametrised about the current estimate at every step, so each step
+    is a plain 6-parameter solve of (JᵀJ + λ diag JᵀJ) δ = −Jᵀe; started from the
+    algebraic circle it converges in two or three steps. Stops when the step would lower
+    the cost by less than 1e-10 of itself (to first order) or is below 1e-10 of the radius.
+    Returns centre, normal, radius, JᵀJ at the end, the cost eᵀe and the number of residuals.
+    """
+    A, g, cost, u, v = _orthogonal_system(pts, sw, c, n, r)
+    lam = 1e-6
+    for _ in range(max_iter):
+        D = np.diag(np.maximum(np.diag(A), 1e-300))
+        try:
+            step = np.linalg.solve(A + lam * D, -g)
+        except np.linalg.LinAlgError:
+            break
+        predicted = -(2.0 * step @ g + step @ A @ step)  # cost decrease of the linear model
+        if predicted <= 1e-10 * cost or np.abs(step).max() <= 1e-10 * abs(r):
+            break  # converged: what is left is rounding
+        nn = n + step[3] * u + step[4] * v
+        nn /= np.linalg.norm(nn)
+        cc, rr = c + step[:3], r + step[5]
+        A2, g2, cost2, u2, v2 = _orthogonal_system(pts, sw, cc, nn, rr)
+        if cost2 < cost:
+            c, n, r, A, g, cost, u, v = cc, nn, rr, A2, g2, cost2, u2, v2
+            lam = max(lam * 0.1, 1e-12)
+        else:
+            lam *= 10.0
+    return c, n, r, A, cost, 2 * len(pts)
 
 
 def _solve(pts, w, c, n, r, cost):
-    """One LM solve from (c, n, r); returns the circle and the solver result."""
-    u, v = _basis(n)
+    """One LM solve from (c, n, r); returns the circle and (JᵀJ, eᵀe, residual count)
+    for the covariance, and the unit scale used."""
     # the orthogonal cost is homogeneous in length: work in millimetres for conditioning.
     # The published cost is not (m² mixed with m): evaluate it in SI units as specified.
-    k = 1e3 if cost == "orthogonal" else 1.0
-    x0 = np.concatenate([c * k, [0.0, 0.0, r * k]])
-    args = (pts * k, np.sqrt(w), n, u, v, cost)
-    jac = _jacobian if cost == "orthogonal" else "2-point"
-    sol = least_squares(_residuals, x0, jac=jac, args=args, method="lm")
+    if cost == "orthogonal":
+        k = 1e3
+        cc, nn, rr, JtJ, ee, m = _lm_orthogonal(pts * k, np.sqrt(w), c * k, n, r * k)
+        return cc / k, nn, rr / k, (JtJ, ee, m), k
+    u, v = _basis(n)
+    x0 = np.concatenate([c, [0.0, 0.0, r]])
+    args = (pts, np.sqrt(w), n, u, v, cost)
+    sol = least_squares(_residuals, x0, jac="2-point", args=args, method="lm")
     cc, nn, rr = _unpack(sol.x, n, u, v)
-    return cc / k, nn, rr / k, sol, k
+    return cc, nn, rr, (sol.jac.T @ sol.jac, 2.0 * sol.cost, sol.jac.shape[0]), 1.0
 
 
 def circle_through(p1: np.ndarray, p2: np.ndarray, p3: np.ndarray):
@@ -207,7 +254,16 @@ def _support(pts: np.ndarray, w: np.ndarray, c: np.ndarray, n: np.ndarray, r: fl
 
 def _sigma(d: np.ndarray, floor: float) -> float:
     """Robust σ of isotropic 2-D residuals from their distances (Rayleigh median)."""
-    return max(float(np.median(d)) / 1.1774, floor)
+    n = len(d)
+    k = n // 2
+    if n == 0:
+        return max(float("nan"), floor)  # as np.median of nothing
+    if n % 2:
+        med = float(np.partition(d, k)[k])
+    else:  # as np.median: the mean of the two middle values
+        part = np.partition(d, [k - 1, k])
+        med = 0.5 * float(part[k - 1] + part[k])
+    return max(med / 1.1774, floor)
 
 
 def fit_circle_3d(
@@ -284,7 +340,7 @@ def fit_circle_3d(
         if inl.sum() < 6:
             inl = np.ones(len(pts), dtype=bool)
     for _ in range(5 if robust else 1):
-        c, n, r, sol, k = _solve(pts[inl], w[inl], c, n, r, cost)
+        c, n, r, system, k = _solve(pts[inl], w[inl], c, n, r, cost)
         if not robust:
             break
         d = orthogonal_distance(pts, c, n, r)
@@ -299,7 +355,7 @@ def fit_circle_3d(
         n = -n
     d_in = orthogonal_distance(pts[inl], c, n, r)
     rms = float(np.sqrt(np.sum(w[inl] * d_in**2) / np.sum(w[inl])))
-    cov_cr, cov_n = _covariance(sol, k)
+    cov_cr, cov_n = _covariance(system, k)
     inliers = np.zeros(len(pts_all), dtype=bool)
     inliers[np.flatnonzero(usable)[inl]] = True
     return Circle3D(
@@ -316,13 +372,13 @@ def fit_circle_3d(
     )
 
 
-def _covariance(sol, k: float) -> tuple[np.ndarray, np.ndarray]:
+def _covariance(system, k: float) -> tuple[np.ndarray, np.ndarray]:
     """Parameter covariance from the final Jacobian, s² (JᵀJ)⁻¹, back in metres."""
-    J = sol.jac
-    m, p = J.shape
-    s2 = 2.0 * sol.cost / max(m - p, 1)
+    JtJ, ee, m = system
+    p = JtJ.shape[0]
+    s2 = ee / max(m - p, 1)
     try:
-        cov = np.linalg.inv(J.T @ J) * s2
+        cov = np.linalg.inv(JtJ) * s2
     except np.linalg.LinAlgError:
         cov = np.full((p, p), np.nan)
     idx = [0, 1, 2, 5]

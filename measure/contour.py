@@ -10,6 +10,7 @@ that ellipse (burrs, false edges) are treated as missing too.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -40,15 +41,25 @@ class Contour:
 def ellipse_distance(pts: np.ndarray, ell: Ellipse) -> np.ndarray:
     """Approximate signed distance (px) of points from an ellipse (radial, normalised)."""
     (cx, cy), (a2, b2), ang = ell
-    t = np.deg2rad(ang)
-    d = pts - (cx, cy)
-    u = d[:, 0] * np.cos(t) + d[:, 1] * np.sin(t)
-    v = -d[:, 0] * np.sin(t) + d[:, 1] * np.cos(t)
-    a, b = a2 / 2.0, b2 / 2.0
-    rel = np.hypot(u / a, v / b)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rad = np.hypot(u, v) / np.maximum(rel, 1e-12)  # ellipse radius along the ray
+    t = math.radians(ang)
+    ct, st = math.cos(t), math.sin(t)
+    dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
+    u = dx * ct + dy * st
+    v = dy * ct - dx * st
+    rel = np.hypot(u * (2.0 / a2), v * (2.0 / b2))
+    rad = np.hypot(u, v) / np.maximum(rel, 1e-12)  # ellipse radius along the ray
     return (rel - 1.0) * rad
+
+
+def _median_abs(d: np.ndarray) -> float:
+    """``np.median(np.abs(d))`` from one partial sort (``d`` not empty)."""
+    a = np.abs(d)
+    n = len(a)
+    k = n // 2
+    if n % 2:
+        return float(np.partition(a, k)[k])
+    part = np.partition(a, [k - 1, k])
+    return float(0.5 * (part[k - 1] + part[k]))
 
 
 def robust_ellipse(
@@ -66,8 +77,10 @@ def robust_ellipse(
     out, so the floor is generous. Seeded, so results are repeatable.
     """
     n = len(pts)
-    ell = cv2.fitEllipse(pts.astype(np.float32))
-    clean = np.count_nonzero(np.abs(ellipse_distance(pts, ell)) < tol_px) >= 0.9 * n
+    pts32 = pts.astype(np.float32)
+    ell = cv2.fitEllipse(pts32)
+    d = ellipse_distance(pts, ell)
+    clean = np.count_nonzero(np.abs(d) < tol_px) >= 0.9 * n
     if n >= 24 and not clean:
         rng = np.random.default_rng(seed)
         bounds = np.linspace(0, n, 7).astype(int)
@@ -86,12 +99,13 @@ def robust_ellipse(
         ell = best
         inl = np.abs(ellipse_distance(pts, ell)) < tol_px
         if inl.sum() >= 6:
-            ell = cv2.fitEllipse(pts[inl].astype(np.float32))
-    d = ellipse_distance(pts, ell)
-    sigma = 1.4826 * float(np.median(np.abs(d)))
+            ell = cv2.fitEllipse(pts32[inl])
+        d = ellipse_distance(pts, ell)
+    sigma = 1.4826 * _median_abs(d)
     inl = np.abs(d) < max(4.0 * sigma, floor_px)
-    if inl.sum() >= 6:
-        ell = cv2.fitEllipse(pts[inl].astype(np.float32))
+    n_in = np.count_nonzero(inl)
+    if 6 <= n_in < n:  # (all of them: the refit is the fit it started from)
+        ell = cv2.fitEllipse(pts32[inl])
         d = ellipse_distance(pts, ell)
         inl = np.abs(d) < max(4.0 * sigma, floor_px)
     ell = (
@@ -142,19 +156,21 @@ def curvature_correction(pts: np.ndarray, ell: Ellipse, sigma_px: float) -> np.n
     ellipse's outward normal by that amount; κ comes from the image ellipse.
     """
     (cx, cy), (a2, b2), ang = ell
-    t = np.deg2rad(ang)
-    c, s = np.cos(t), np.sin(t)
+    t = math.radians(ang)
+    c, s = math.cos(t), math.sin(t)
     a, b = a2 / 2.0, b2 / 2.0
-    d = pts - (cx, cy)
-    u = d[:, 0] * c + d[:, 1] * s
-    v = -d[:, 0] * s + d[:, 1] * c
+    dx, dy = pts[:, 0] - cx, pts[:, 1] - cy
+    u = dx * c + dy * s
+    v = dy * c - dx * s
     phi = np.arctan2(v / b, u / a)
-    kappa = a * b / (a * a * np.sin(phi) ** 2 + b * b * np.cos(phi) ** 2) ** 1.5
-    nu, nv = np.cos(phi) / a, np.sin(phi) / b  # outward normal ∝ (u/a², v/b²)
-    norm = np.hypot(nu, nv)
-    nu, nv = nu / norm, nv / norm
-    shift = 0.5 * sigma_px**2 * kappa
-    return pts + shift[:, None] * np.stack([nu * c - nv * s, nu * s + nv * c], axis=1)
+    cp, sp = np.cos(phi), np.sin(phi)
+    kappa = a * b / (a * a * sp**2 + b * b * cp**2) ** 1.5
+    nu, nv = cp / a, sp / b  # outward normal ∝ (u/a², v/b²)
+    shift = (0.5 * sigma_px**2) * kappa / np.hypot(nu, nv)
+    out = np.empty_like(pts)
+    out[:, 0] = pts[:, 0] + shift * (nu * c - nv * s)
+    out[:, 1] = pts[:, 1] + shift * (nu * s + nv * c)
+    return out
 
 
 def build_contour(
@@ -185,7 +201,7 @@ def build_contour(
     n_out = int((~inl).sum())
     theta, r = theta[inl], r[inl]
     r_mean = float(np.mean(r))
-    n_lines = int(np.clip(round(np.pi * r_mean / arc_step_px), 24, max_points // 2))
+    n_lines = min(max(round(math.pi * r_mean / arc_step_px), 24), max_points // 2)
     ang = -np.pi + np.pi * np.arange(2 * n_lines) / n_lines
     # angular distance from each line to the nearest measured sample (periodic)
     j = np.searchsorted(theta, ang) % len(theta)

@@ -16,11 +16,13 @@ chamfer rings and the bore's bottom edge do not enter.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import cv2
 import numpy as np
 
 from measure.detect import HoleCandidate
+from measure.masks import above, below, grow_box, ring_mask
 from measure.outline import without_bites
 from measure.slope import slope_shift
 
@@ -63,18 +65,23 @@ class EdgePoints:
 
 
 def _median(img: np.ndarray, mask: np.ndarray, full: float) -> float | None:
-    """Median gray level (fraction of full scale) of the masked pixels, from a histogram."""
-    if not mask.any():
-        return None
+    """Median gray level (fraction of full scale) of the masked pixels (a nonzero ``uint8``
+    or bool mask), from a histogram; ``None`` when no pixel is masked."""
     bins = 256 if img.dtype == np.uint8 else 1024
     hist = cv2.calcHist([img], [0], mask.view(np.uint8), [bins], [0, full + 1]).ravel()
     cdf = np.cumsum(hist)
+    if cdf[-1] <= 0:
+        return None
     k = int(np.searchsorted(cdf, 0.5 * cdf[-1]))
     return (k + 0.5) * (full + 1) / bins / full
 
 
-def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
-    """The filled outer outline of the mask component around ``seed`` (ROI pixels).
+Box = tuple[int, int, int, int]
+
+
+def _region(mask: np.ndarray, seed: tuple[float, float]) -> tuple[np.ndarray, Box | None]:
+    """The filled outer outline of the mask component around ``seed`` (ROI pixels), and
+    its bounding box (x, y, w, h; ``None`` when there is no component).
 
     Islands inside the hole (a screw) do not matter; a bite into the outline (a screw
     head touching the rim in the image) is bridged by the ellipse through the rest.
@@ -84,9 +91,10 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
     pool = inside or list(contours)
     region = np.zeros(mask.shape, np.uint8)
     if not pool:
-        return region
+        return region, None
     c = max(pool, key=cv2.contourArea)
     cv2.drawContours(region, [c], -1, 1, thickness=cv2.FILLED)
+    box = cv2.boundingRect(c)
     area = cv2.contourArea(c)
     hull_area = cv2.contourArea(cv2.convexHull(c))
     if len(c) >= 24 and area < 0.97 * hull_area:
@@ -95,12 +103,8 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> np.ndarray:
             ell = cv2.fitEllipse(rest.astype(np.float32))
             if np.all(np.isfinite(ell[1])) and min(ell[1]) > 2:
                 cv2.ellipse(region, ell, 1, thickness=cv2.FILLED)
-    return region
-
-
-def _ring(outside_px: np.ndarray, inner: float, outer: float) -> np.ndarray:
-    """Pixels between ``inner`` and ``outer`` px outside the region (from its distance map)."""
-    return (outside_px > inner) & (outside_px <= outer)
+                box = cv2.boundingRect(region)
+    return region, box
 
 
 def hole_region(
@@ -114,14 +118,15 @@ def hole_region(
     rim where the light is uneven, and lies on the middle of a soft edge. For a bright
     interior (a through-hole against a lit background) pixels as far *below* the
     surrounding level are part of the hole too: the bore wall, seen at a tilt as a dark
-    crescent between the background and the rim.
+    crescent between the background and the rim. Masks, erosion, the inner ring and the
+    moments are worked out on the region's box (plus what they reach), not the whole crop.
     """
     H, W = img.shape
     x, y, w, h = cand.bbox
     m = margin_px + int(0.12 * max(w, h))
     x0, y0 = max(x - m, 0), max(y - m, 0)
     x1, y1 = min(x + w + m, W), min(y + h + m, H)
-    roi_img = np.ascontiguousarray(img[y0:y1, x0:x1])
+    roi_img = img[y0:y1, x0:x1]
     cx, cy = cand.centroid_px
     seed = (float(cx - x0), float(cy - y0))
     box = (x0, y0, x1 - x0, y1 - y0)
@@ -129,42 +134,50 @@ def hole_region(
     level = cand.threshold
     surf = cand.surface_level
     if dark:
-        first = roi_img <= level * full
+        first = below(roi_img, level * full)
     elif surf is None or level <= surf:
-        first = roi_img > level * full
+        first = above(roi_img, level * full)
     else:  # the lit background and the wall crescent beside it (measure.opening)
-        first = (roi_img > level * full) | (roi_img < (2 * surf - level) * full)
-    region = _region(first, seed)
+        first = above(roi_img, level * full) | (roi_img < (2 * surf - level) * full)
+    region, rbox = _region(first, seed)
     inside = outside = level
     dist = None
-    if region.any():
+    if rbox is not None:
         k = max(4, int(0.03 * cand.diameter_px))
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
-        core = cv2.erode(region, ker) > 0
-        dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)  # px outside the region
-        lout = _median(roi_img, _ring(dist, 3, 3 + k), full)
+        ys, xs, _, _ = grow_box(rbox, 3, region.shape)  # the kernel's reach: zeros round the box
+        core = np.zeros(region.shape, np.uint8)
+        core[ys, xs] = cv2.erode(region[ys, xs], ker)
+        dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
+        ys, xs, _, _ = grow_box(rbox, 5 + 2 * k, region.shape)  # holds the ring 3 … 3 + k px
+        lout = _median(roi_img[ys, xs], ring_mask(dist[ys, xs], 3, 3 + k), full)
         if not dark and lout is not None:  # the lit part only, not the wall crescent
-            core &= roi_img > lout * full
+            core &= above(roi_img, lout * full)
         lin = _median(roi_img, core, full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
             if dark:
-                mask = roi_img <= level * full
+                mask = below(roi_img, level * full)
             else:  # a lit background: the bore wall seen at a tilt is a dark crescent
-                mask = (roi_img > level * full) | (roi_img < (2 * lout - level) * full)
-            refined = _region(mask, seed)
-            ratio = float(refined.sum()) / float(region.sum())
-            if 0.6 < ratio < 1.6:  # the same region, better placed; else keep the first
-                region = refined  # (moved by a pixel or two: the first distance map serves)
-    mom = cv2.moments(region, binaryImage=True)
+                mask = above(roi_img, level * full) | (roi_img < (2 * lout - level) * full)
+            refined, fbox = _region(mask, seed)
+            ratio = float(cv2.countNonZero(refined)) / float(cv2.countNonZero(region))
+            # the same region, better placed; else keep the first (moved by a pixel or two:
+            # the first distance map serves)
+            if 0.6 < ratio < 1.6:
+                region, rbox = refined, fbox
+    if rbox is None:
+        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
+    bx, by = rbox[:2]
+    mom = cv2.moments(region[by : by + rbox[3], bx : bx + rbox[2]], binaryImage=True)
     if mom["m00"] <= 0:
         return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
-    centroid = (mom["m10"] / mom["m00"] + x0, mom["m01"] / mom["m00"] + y0)
+    centroid = (mom["m10"] / mom["m00"] + bx + x0, mom["m01"] / mom["m00"] + by + y0)
     d = 2.0 * np.sqrt(mom["m00"] / np.pi)
     if dist is None:
-        dist = cv2.distanceTransform(1 - region, cv2.DIST_L2, 3)
-    wide = _median(roi_img, _ring(dist, 0.05 * d, 0.2 * d), full)
+        dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
+    wide = _median(roi_img, ring_mask(dist, 0.05 * d, 0.2 * d), full)
     return HoleRegion(
         box,
         centroid,
@@ -177,11 +190,65 @@ def hole_region(
     )
 
 
+def _percentile(a: np.ndarray, q: float) -> float:
+    """``np.percentile(a, q)`` (linear interpolation; equal to NumPy's to the last bit of
+    ``a``'s precision) from one partial sort, without NumPy's generic bookkeeping; ``a``
+    is 1-D and not empty."""
+    n = len(a)
+    pos = q / 100.0 * (n - 1)
+    lo = int(np.floor(pos))
+    hi = min(lo + 1, n - 1)
+    part = np.partition(a, [lo, hi] if hi > lo else [lo])
+    b0, b1, t = float(part[lo]), float(part[hi]), pos - lo
+    d = b1 - b0
+    return float(a.dtype.type(b1 - d * (1.0 - t) if t >= 0.5 else b0 + d * t))
+
+
+def _band(region: np.ndarray, half_width: int) -> np.ndarray:
+    """:func:`outline_band` as a 0/1 ``uint8`` mask."""
+    u8 = region.view(np.uint8)
+    k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * half_width + 1, 2 * half_width + 1))
+    return cv2.subtract(cv2.dilate(u8, k), cv2.erode(u8, k))
+
+
 def outline_band(region: np.ndarray, half_width: int) -> np.ndarray:
     """Pixels within ``half_width`` of the region outline."""
     u8 = region.astype(np.uint8)
     k = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * half_width + 1, 2 * half_width + 1))
     return cv2.dilate(u8, k) > cv2.erode(u8, k)
+
+
+@lru_cache(maxsize=16)
+def gradient_kernels(sigma_px: float, full: float) -> tuple[np.ndarray, np.ndarray]:
+    """Separable kernels (derivative, smoothing) of Sobel ∘ Gaussian, scaled by 1/``full``.
+
+    ``cv2.sepFilter2D(img, CV_32F, d, s)`` is then ``Sobel_x(GaussianBlur(img / full, σ))``
+    in one pass on the raw image (``(s, d)``: the y derivative): the Gaussian of
+    ``cv2.GaussianBlur`` for a float image (``getGaussianKernel`` of size round(8σ + 1) | 1)
+    convolved with Sobel's [−1, 0, 1] and [1, 2, 1]. Equal to the two passes up to
+    rounding, away from the border.
+    """
+    if sigma_px > 0:
+        k = round(sigma_px * 8 + 1) | 1
+        g = cv2.getGaussianKernel(k, sigma_px, cv2.CV_32F).ravel().astype(np.float64)
+    else:
+        g = np.ones(1)
+    d = np.convolve(g, [-1.0, 0.0, 1.0]) / full
+    sm = np.convolve(g, [1.0, 2.0, 1.0])
+    return d.astype(np.float32), sm.astype(np.float32)
+
+
+#: pixels the edge step reads beyond the band: kernel reach (3), the parabola's neighbour
+#: and the linear method's ±3 px, with one to spare
+_CROP_MARGIN_PX = 7
+
+
+def _edge_crop(mask: np.ndarray, band_px: int) -> tuple[int, int, int, int]:
+    """(x0, y0, x1, y1) of the ROI part the edge step needs: the outline band and its reach."""
+    bx, by, bw, bh = cv2.boundingRect(mask.view(np.uint8))
+    m = band_px + _CROP_MARGIN_PX
+    H, W = mask.shape
+    return max(bx - m, 0), max(by - m, 0), min(bx + bw + m, W), min(by + bh + m, H)
 
 
 def subpixel_edges(
@@ -194,45 +261,62 @@ def subpixel_edges(
 ) -> EdgePoints:
     """Canny edge pixels near the hole outline, refined to sub-pixel points.
 
-    With ``slope_correction`` (``"parabola"`` only) each gradient maximum is moved back by
-    the shift a brightness slope beside the edge causes (:mod:`measure.slope`).
+    Only the part of the ROI around the outline band is filtered (the region's box plus
+    the filters' reach), and smoothing and gradient are one separable pass each
+    (:func:`gradient_kernels`). With ``slope_correction`` (``"parabola"`` only) each
+    gradient maximum is moved back by the shift a brightness slope beside the edge
+    causes (:mod:`measure.slope`).
     """
     if method not in EDGE_METHODS:
         raise ValueError(f"edge method must be one of {EDGE_METHODS}, got {method!r}")
-    x0, y0, w, h = region.roi
-    raw = img[y0 : y0 + h, x0 : x0 + w].astype(np.float32) * np.float32(1.0 / full)
-    smooth = cv2.GaussianBlur(raw, (0, 0), sigma_px) if sigma_px > 0 else raw
-    gx = cv2.Sobel(smooth, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(smooth, cv2.CV_32F, 0, 1, ksize=3)
-    mag = cv2.magnitude(gx, gy)
-    band = outline_band(region.mask, 3)
-    if not band.any():
+    if not region.mask.any():
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
-    peak = float(np.percentile(mag[band], 98))
+    rx, ry = region.roi[:2]
+    cx0, cy0, cx1, cy1 = _edge_crop(region.mask, 3)
+    x0, y0, w, h = rx + cx0, ry + cy0, cx1 - cx0, cy1 - cy0
+    sub = img[y0 : y0 + h, x0 : x0 + w]
+    kd, ks = gradient_kernels(float(sigma_px), float(full))
+    gx = cv2.sepFilter2D(sub, cv2.CV_32F, kd, ks)
+    gy = cv2.sepFilter2D(sub, cv2.CV_32F, ks, kd)
+    mag = cv2.magnitude(gx, gy)
+    band = _band(region.mask[cy0:cy1, cx0:cx1], 3)  # 0/1
+    vals = mag[band.view(bool)]
+    if len(vals) == 0:
+        return EdgePoints(np.zeros((0, 2)), np.zeros(0))
+    peak = _percentile(vals, 98.0)
     if peak <= 0:
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
-    scale = 16000.0 / max(float(mag.max()), 1e-12)
-    dx = np.clip(gx * scale, -32767, 32767).astype(np.int16)
-    dy = np.clip(gy * scale, -32767, 32767).astype(np.int16)
-    hi = 0.35 * peak * scale
-    edges = cv2.Canny(dx, dy, 0.5 * hi, hi, L2gradient=True) > 0
-    ys, xs = np.nonzero(edges & band)
+    scale = np.float32(16000.0 / max(float(mag.max()), 1e-12))  # |g| ≤ max: no clipping
+    dx = (gx * scale).astype(np.int16)
+    dy = (gy * scale).astype(np.int16)
+    hi = 0.35 * peak * float(scale)
+    edges = cv2.Canny(dx, dy, 0.5 * hi, hi, L2gradient=True)
+    found = cv2.findNonZero(cv2.bitwise_and(edges, band))  # row by row, as np.nonzero
+    if found is None:
+        return EdgePoints(np.zeros((0, 2)), np.zeros(0))
+    found = found.reshape(-1, 2).astype(np.intp)
+    xs, ys = found[:, 0], found[:, 1]
     keep = (xs >= 3) & (ys >= 3) & (xs < w - 3) & (ys < h - 3)
     xs, ys = xs[keep], ys[keep]
-    horiz = np.abs(gx[ys, xs]) >= np.abs(gy[ys, xs])
-    sx, sy = horiz.astype(np.int64), (~horiz).astype(np.int64)
+    gxs, gys = gx[ys, xs], gy[ys, xs]
+    horiz = np.abs(gxs) >= np.abs(gys)
+    sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
+    # the gradient magnitude at each pixel and its two neighbours along the dominant axis
+    g0 = mag[ys, xs].astype(np.float64)
+    gm = mag[ys - sy, xs - sx].astype(np.float64)
+    gp = mag[ys + sy, xs + sx].astype(np.float64)
     if method == "parabola":
-        off, ok = _parabola(mag, xs, ys, sx, sy)
+        off, ok = _parabola(gm, g0, gp)
     else:
+        raw = sub.astype(np.float32) * np.float32(1.0 / full)
         off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
     pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
-    xs, ys = xs[ok], ys[ok]
-    widths = _edge_widths(mag, gx, gy, xs, ys, sx[ok], sy[ok])
+    gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
+    widths = _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
     finite = widths[np.isfinite(widths)]
-    blur = float(np.median(finite)) if len(finite) else 0.0
-    strength = mag[ys, xs].astype(np.float64)
+    blur = _percentile(finite, 50.0) if len(finite) else 0.0
     if slope_correction and method == "parabola" and len(pts):
-        normals = np.stack([gx[ys, xs], gy[ys, xs]], axis=1) / np.maximum(strength, 1e-12)[:, None]
+        normals = np.stack([gxs, gys], axis=1) / np.maximum(strength, 1e-12)[:, None]
         centre = (region.centroid_px[0] - x0, region.centroid_px[1] - y0)
         shift = slope_shift(gx, gy, pts, normals, strength, blur, centre)
         pts -= shift[:, None] * normals
@@ -244,23 +328,21 @@ def subpixel_edges(
     )
 
 
-def _edge_widths(mag, gx, gy, xs, ys, sx, sy) -> np.ndarray:
-    """Gaussian width (px) of the gradient profile across the edge at each point (inf: none)."""
-    lg = [
-        np.log(np.maximum(mag[ys + k * sy, xs + k * sx].astype(np.float64), 1e-12))
-        for k in (-1, 0, 1)
-    ]
-    curv = lg[0] - 2.0 * lg[1] + lg[2]
-    g = np.maximum(np.hypot(gx[ys, xs], gy[ys, xs]).astype(np.float64), 1e-12)
-    along = np.where(sx == 1, np.abs(gx[ys, xs]), np.abs(gy[ys, xs])) / g
+def _edge_widths(gm, g0, gp, gxs, gys, horiz) -> np.ndarray:
+    """Gaussian width (px) of the gradient profile across the edge at each point (inf: none),
+    from the magnitudes before, at and after it along the dominant axis (float64) and the
+    gradient there (float32)."""
+    lg0 = np.log(np.maximum(g0, 1e-12))
+    curv = np.log(np.maximum(gm, 1e-12)) - 2.0 * lg0 + np.log(np.maximum(gp, 1e-12))
+    g = np.maximum(np.hypot(gxs, gys).astype(np.float64), 1e-12)
+    along = np.where(horiz, np.abs(gxs), np.abs(gys)) / g
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(curv < 0, np.sqrt(-1.0 / curv) * along, np.inf)
 
 
-def _parabola(mag, xs, ys, sx, sy) -> tuple[np.ndarray, np.ndarray]:
-    g0 = mag[ys, xs].astype(np.float64)
-    gm = mag[ys - sy, xs - sx].astype(np.float64)
-    gp = mag[ys + sy, xs + sx].astype(np.float64)
+def _parabola(gm, g0, gp) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex offset (px, along the dominant axis) of the parabola through the magnitudes
+    before, at and after each pixel, and where it is a maximum within half a pixel."""
     den = gm - 2.0 * g0 + gp
     ok = (den < 0) & (g0 >= gm) & (g0 >= gp)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -44,16 +44,18 @@ def _flanks(pts: np.ndarray) -> list[np.ndarray]:
 
 def _steep(pts: np.ndarray, min_sin: float) -> np.ndarray:
     """Samples whose contour tangent is steeper than ``asin(min_sin)`` to the rows."""
-    t = np.roll(pts, -1, axis=0) - np.roll(pts, 1, axis=0)
+    t = np.empty_like(pts)  # next minus previous sample, around the closed contour
+    t[1:-1] = pts[2:] - pts[:-2]
+    t[0] = pts[1] - pts[-1]
+    t[-1] = pts[0] - pts[-2]
     return np.abs(t[:, 1]) > min_sin * np.hypot(t[:, 0], t[:, 1])
 
 
-def _one_way(src, src_w, src_f, dst, dst_w, dst_f, min_sin):
-    """Match samples of ``src`` into the contour ``dst`` (both rectified, ordered, closed)."""
+def _one_way(src, src_w, src_f, dst, dst_w, dst_f, steep_src, steep_dst, flanks_src, flanks_dst):
+    """Match samples of ``src`` into the contour ``dst`` (both rectified, ordered, closed;
+    their :func:`_steep` masks and :func:`_flanks` given)."""
     out_x, out_w, out_f, out_i = [], [], [], []
-    steep_src = _steep(src, min_sin)
-    steep_dst = _steep(dst, min_sin)
-    for fs, fd in zip(_flanks(src), _flanks(dst), strict=True):
+    for fs, fd in zip(flanks_src, flanks_dst, strict=True):
         yd = dst[fd, 1]
         mono = np.concatenate([[True], np.diff(yd) > 0])
         fd = fd[mono]
@@ -96,14 +98,18 @@ def match_contours(
 ) -> Matches:
     """Match two closed rectified contours row by row, flank to flank (see module doc)."""
     min_sin = float(np.sin(np.deg2rad(min_angle_deg)))
+    steep_l, steep_r = _steep(left_rect, min_sin), _steep(right_rect, min_sin)
+    flanks_l, flanks_r = _flanks(left_rect), _flanks(right_rect)
     xr, wl, fl, il = _one_way(
-        left_rect, left_weight, left_filled, right_rect, right_weight, right_filled, min_sin
-    )
+        left_rect, left_weight, left_filled, right_rect, right_weight, right_filled,
+        steep_l, steep_r, flanks_l, flanks_r,
+    )  # fmt: skip
     Ls, Rs, Ws, Fs, Ss, Is = [left_rect[il]], [xr], [wl], [fl], [np.zeros(len(il), int)], [il]
     if both_ways:
         xl, wr, fr, ir = _one_way(
-            right_rect, right_weight, right_filled, left_rect, left_weight, left_filled, min_sin
-        )
+            right_rect, right_weight, right_filled, left_rect, left_weight, left_filled,
+            steep_r, steep_l, flanks_r, flanks_l,
+        )  # fmt: skip
         Ls.append(xl)
         Rs.append(right_rect[ir])
         Ws.append(wr)

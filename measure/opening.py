@@ -27,19 +27,29 @@ import numpy as np
 from measure.detect import SEARCH_SCALE, HoleCandidate
 from measure.outline import disc_like
 
+#: unit circle at 96 angles, and the three radii (× d) the surface level is read on
+_COS_SIN = np.stack([np.cos(np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)),
+                     np.sin(np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False))])  # fmt: skip
+_RADII = np.array([1.0, 1.25, 1.5])
+
 
 def surface_level_search(small: np.ndarray, cx: float, cy: float, d: float) -> float:
     """Median of the search image (0 … 255) on circles 1.0, 1.25 and 1.5 × ``d`` from
     (``cx``, ``cy``) (search pixels): the surface beyond the hole."""
-    ang = np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)
-    rad = d * np.array([1.0, 1.25, 1.5])
-    xs = np.rint(cx + np.outer(rad, np.cos(ang))).astype(int).ravel()
-    ys = np.rint(cy + np.outer(rad, np.sin(ang))).astype(int).ravel()
+    rad = d * _RADII
+    xs = np.rint(cx + np.outer(rad, _COS_SIN[0])).astype(int).ravel()
+    ys = np.rint(cy + np.outer(rad, _COS_SIN[1])).astype(int).ravel()
     H, W = small.shape
     ok = (xs >= 0) & (ys >= 0) & (xs < W) & (ys < H)
     if not ok.any():
         return float(np.median(small))
-    return float(np.median(small[ys[ok], xs[ok]]))
+    vals = small[ys[ok], xs[ok]]
+    n = len(vals)
+    k = n // 2
+    if n % 2:
+        return float(np.partition(vals, k)[k])
+    part = np.partition(vals, [k - 1, k])
+    return 0.5 * (float(part[k - 1]) + float(part[k]))  # as np.median
 
 
 def with_wall_crescent(small: np.ndarray, cand: HoleCandidate) -> HoleCandidate:

@@ -3,8 +3,11 @@ the outline without the concave bites something inside the bore takes out of it.
 
 from __future__ import annotations
 
+import math
+
 import cv2
 import numpy as np
+from numba import njit
 
 
 def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray | None:
@@ -37,20 +40,41 @@ def without_bites(contour: np.ndarray, min_depth_px: float = 1.5) -> np.ndarray 
 
 
 def disc_like(pts: np.ndarray, shape: tuple[int, int], border: bool) -> bool:
-    """Does the outline (N, 2) (away from the image border) follow an ellipse?"""
+    """Does the outline (N, 2) (away from the image border) follow an ellipse?
+
+    ``pts`` may be float or OpenCV's int32 contour points (then used as they are)."""
+    pts = pts.reshape(-1, 2)
     if border:
         H, W = shape
         keep = (pts[:, 0] > 0) & (pts[:, 1] > 0) & (pts[:, 0] < W - 1) & (pts[:, 1] < H - 1)
         pts = pts[keep]
-    if len(pts) < 12:
+    n = len(pts)
+    if n < 12:
         return False
-    (cx, cy), (a2, b2), ang = cv2.fitEllipse(pts.astype(np.float32))
-    if not np.isfinite(a2 + b2) or min(a2, b2) <= 2 or min(a2, b2) / max(a2, b2) < 0.35:
+    ell_pts = pts if pts.dtype in (np.int32, np.float32) else pts.astype(np.float32)
+    (cx, cy), (a2, b2), ang = cv2.fitEllipse(ell_pts)
+    if not math.isfinite(a2 + b2) or min(a2, b2) <= 2 or min(a2, b2) / max(a2, b2) < 0.35:
         return False
-    t = np.deg2rad(ang)
-    d = pts - (cx, cy)
-    u = d[:, 0] * np.cos(t) + d[:, 1] * np.sin(t)
-    v = -d[:, 0] * np.sin(t) + d[:, 1] * np.cos(t)
-    rel = np.abs(np.hypot(u / (a2 / 2), v / (b2 / 2)) - 1.0)
+    t = math.radians(ang)
     tol = max(0.06, 1.5 / (0.5 * min(a2, b2)))
-    return float(np.median(rel)) < tol / 2 and float(np.mean(rel < tol)) > 0.6
+    median, within = _ellipse_fit(pts, cx, cy, math.cos(t), math.sin(t), 2.0 / a2, 2.0 / b2, tol)
+    return median < tol / 2 and within > 0.6 * n
+
+
+@njit(cache=True)
+def _ellipse_fit(pts, cx, cy, c, s, ia, ib, tol):
+    """Median of |ρ − 1| (ρ: each point's normalised radius on the ellipse centred at
+    (cx, cy), axes at angle (c, s), inverse half axes ia, ib) and how many are below
+    ``tol``; one compiled pass instead of a dozen array operations (the disc test runs
+    ten times a pair)."""
+    n = pts.shape[0]
+    rel = np.empty(n)
+    within = 0
+    for i in range(n):
+        dx, dy = pts[i, 0] - cx, pts[i, 1] - cy
+        u = (dx * c + dy * s) * ia
+        v = (dy * c - dx * s) * ib
+        rel[i] = abs(np.sqrt(u * u + v * v) - 1.0)
+        if rel[i] < tol:
+            within += 1
+    return np.median(rel), within

@@ -245,8 +245,8 @@ def measure_hole(
         MeasurementError subclasses for every bad input (see :mod:`measure.errors`).
     """
     opts = options or MeasureOptions()
-    t = {}
-    t0 = time.perf_counter()
+    t, cpu = {}, {}
+    t0, c0 = time.perf_counter(), time.thread_time()
     left, right = to_gray(left, "left"), to_gray(right, "right")
     if left.shape != right.shape:
         raise ImageError("pair", f"left is {left.shape} but right is {right.shape} (h, w)")
@@ -267,15 +267,15 @@ def measure_hole(
     cand_r, oth_r = ([with_wall_crescent(small_r, c) for c in cs] for cs in (cand_r, oth_r))
     pair_args = (stereo, expected_diameter_m, opts.size_tolerance, expected_standoff_m)
     cl, cr, check = _pick(cand_l, cand_r, oth_l, oth_r, pair_args)
-    t["detect"] = time.perf_counter() - t0
+    t["detect"], cpu["detect"] = time.perf_counter() - t0, time.thread_time() - c0
 
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.thread_time()
     con_l, reg_l = _contour(left, full_l, cl, opts, "left")
     con_r, reg_r = _contour(right, full_r, cr, opts, "right")
     rim = _rim(cl, cr, reg_l, reg_r, small_l, small_r, check.depth_m)
-    t["edges"] = time.perf_counter() - t1
+    t["edges"], cpu["edges"] = time.perf_counter() - t1, time.thread_time() - c1
 
-    t2 = time.perf_counter()
+    t2, c2 = time.perf_counter(), time.thread_time()
     rl = stereo.undistort_rectify(con_l.points_px, "left")
     rr = stereo.undistort_rectify(con_r.points_px, "right")
     m = match_contours(
@@ -288,11 +288,11 @@ def measure_hole(
         opts.min_epipolar_angle_deg,
     )
     pts = triangulate(stereo, m.left_rect, m.right_rect)
-    t["match"] = time.perf_counter() - t2
+    t["match"], cpu["match"] = time.perf_counter() - t2, time.thread_time() - c2
     if int((m.weight > 0).sum()) < 12:
         raise EdgeError("stereo matching", int((m.weight > 0).sum()), 12)
 
-    t3 = time.perf_counter()
+    t3, c3 = time.perf_counter(), time.thread_time()
     if opts.robust and opts.near_side_max_angle_deg is not None:
         cams = np.stack([np.zeros(3), stereo.right_center_in_left])
         circ, _ = fit_with_near_side_check(
@@ -300,7 +300,7 @@ def measure_hole(
         )
     else:
         circ = fit_circle_3d(pts, m.weight, cost=opts.circle_cost, robust=opts.robust)
-    t["fit"] = time.perf_counter() - t3
+    t["fit"], cpu["fit"] = time.perf_counter() - t3, time.thread_time() - c3
     if expected_diameter_m is not None:
         d = 2 * circ.radius
         if abs(d / expected_diameter_m - 1.0) > opts.size_tolerance:
@@ -341,4 +341,5 @@ def measure_hole(
         options=opts,
         rim=rim,
         suspect_reasons=reasons,
+        cpu_timings=cpu,
     )

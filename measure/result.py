@@ -154,7 +154,9 @@ class HoleMeasurement:
         n_points / n_rejected / n_filled: 3-D points used by the fit, rejected as outliers,
             and contour samples filled over broken edges (both images).
         cov_center_radius: 4×4 covariance of (cx, cy, cz, r) from the fit (m²).
-        timings: seconds per stage; ``time_s`` the total.
+        timings: seconds per stage (wall clock); ``time_s`` the total. ``cpu_timings``:
+            the CPU seconds the calling thread spent per stage (``time.thread_time``; on a
+            shared machine the wall clock includes waiting for a core).
         edges_left_px / edges_right_px: contour samples (N, 2) in each image (distorted
             pixels); ``filled_left`` / ``filled_right`` mark the filled ones.
         ellipse_left / ellipse_right: robust image ellipses, ``cv2.fitEllipse`` style
@@ -189,6 +191,7 @@ class HoleMeasurement:
     options: MeasureOptions = field(default_factory=MeasureOptions)
     rim: RimChoice | None = None
     suspect_reasons: tuple[str, ...] = ()
+    cpu_timings: dict[str, float] = field(default_factory=dict)
 
     @property
     def diameter_m(self) -> float:
@@ -213,4 +216,5 @@ class HoleMeasurement:
             "cov_center_radius_m2": self.cov_center_radius.tolist(),
             "time_s": float(self.time_s),
             "timings_s": {k: float(v) for k, v in self.timings.items()},
+            "cpu_timings_s": {k: float(v) for k, v in self.cpu_timings.items()},
         }

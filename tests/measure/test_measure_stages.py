@@ -162,3 +162,57 @@ def test_reference_target_renders_and_measures():
     r = render_reference_pair(st, c, n, 0.010, seed=2)
     m = measure_hole(r.left, r.right, st, expected_diameter_m=0.010)
     assert abs(m.radius_m - 0.005) < 3e-6 and np.linalg.norm(m.center_m - c) < 10e-6
+
+
+def test_circle_lm_reaches_the_minimum_scipy_finds():
+    """The hand-written LM of the orthogonal cost against scipy's MINPACK LM on the same
+    residuals (numerical Jacobian), from the same rough start."""
+    from scipy.optimize import least_squares
+
+    from measure.circle import _basis, _residuals, _unpack, initial_circle
+
+    rng = np.random.default_rng(7)
+    for noise, arc in ((1e-6, 2 * np.pi), (20e-6, 2 * np.pi), (3e-6, 2.1)):
+        p, *_, phi = _circle_points(600, noise, rng)
+        p = p[phi < arc]  # a third of the rim: the rough start is far off
+        w = rng.uniform(0.5, 1.0, len(p))
+        ours = fit_circle_3d(p, w, robust=False)
+        c0, n0, r0 = initial_circle(p, w)
+        u, v = _basis(n0)
+        x0 = np.concatenate([c0 * 1e3, [0.0, 0.0, r0 * 1e3]])
+        args = (p * 1e3, np.sqrt(w), n0, u, v, "orthogonal")
+        sol = least_squares(_residuals, x0, args=args, method="lm", xtol=1e-14, ftol=1e-14)
+        cs, ns, rs = _unpack(sol.x, n0, u, v)
+        assert np.linalg.norm(ours.center - cs / 1e3) < 1e-9
+        assert abs(ours.radius - rs / 1e3) < 1e-9
+        assert abs(ours.normal @ ns) > np.cos(1e-6)
+        mine = orthogonal_distance(p, ours.center, ours.normal, ours.radius)
+        theirs = orthogonal_distance(p, cs / 1e3, ns, rs / 1e3)
+        assert np.sum(w * mine**2) <= np.sum(w * theirs**2) * (1 + 1e-9)
+
+
+def test_circle_kernels_match_the_array_expressions():
+    from measure.circle import _basis
+    from measure.circle_kernels import orthogonal_system
+
+    rng = np.random.default_rng(11)
+    p, c, n, r, _ = _circle_points(200, 30e-6, rng)
+    p, c, r = p * 1e3, c * 1e3 + 0.01, r * 1e3 * 1.001  # mm, a little off the optimum
+    sw = np.sqrt(rng.uniform(0.2, 1.0, len(p)))
+    u, v = _basis(n)
+    A, g, ee = orthogonal_system(p, sw, c, n, u, v, r)
+    d = p - c
+    h = d @ n
+    q = d - np.outer(h, n)
+    rho = np.linalg.norm(q, axis=1)
+    e = np.concatenate([h * sw, (rho - r) * sw])
+    Jh = np.column_stack([np.tile(-n, (len(p), 1)), d @ u, d @ v, np.zeros(len(p))])
+    Jr = np.column_stack([-q / rho[:, None], -(h / rho) * (d @ u), -(h / rho) * (d @ v),
+                          -np.ones(len(p))])  # fmt: skip
+    J = np.vstack([Jh * sw[:, None], Jr * sw[:, None]])
+    np.testing.assert_allclose(A, J.T @ J, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(g, J.T @ e, rtol=1e-10, atol=1e-12)
+    assert ee == pytest.approx(e @ e, rel=1e-12)
+    np.testing.assert_allclose(
+        orthogonal_distance(p, c, n, r), np.hypot(h, rho - r), rtol=1e-12, atol=1e-12
+    )
