@@ -113,12 +113,7 @@ def tolerance(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi, capped: set[st
     mod = obj.GetMaterialRequirementModifier()
     condition = "MMC" if mod == MOD_M else "LMC" if mod == MOD_L else "RFS"
     for h in on:
-        bore = geo.bore_of(h, faces)
-        if bore is not None and abs(bore - h.diameter_m) > SAME_SIZE_M:
-            pmi.unmodelled.append(
-                f"{what} on {h.id}: on its {bore * 1e3:g} mm bore, the cell measures the "
-                f"{h.diameter_m * 1e3:g} mm entry bore"
-            )
+        if _on_another_bore(pmi, geo, what, h, faces):
             continue
         held = pmi.tolerances.setdefault(h.id, {})
         if "position" in held:
@@ -170,12 +165,7 @@ def dimension(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
         pmi.unmodelled.append(f"{what} ({where})")
         return
     for h in on:
-        bore = geo.bore_of(h, faces)
-        if bore is not None and abs(bore - h.diameter_m) > SAME_SIZE_M:
-            pmi.unmodelled.append(
-                f"{what} on {h.id}: on its {bore * 1e3:g} mm bore, the cell measures the "
-                f"{h.diameter_m * 1e3:g} mm entry bore"
-            )
+        if _on_another_bore(pmi, geo, what, h, faces):
             continue
         drawn_at_nominal = abs(nominal_mm * MM_TO_M - h.diameter_m) <= SAME_SIZE_M
         if not drawn_at_nominal:
@@ -196,3 +186,16 @@ def dimension(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
             "lower_m": round((lower_mm - base_mm) * MM_TO_M, 12),
             "pmi_id": name,
         }
+
+
+def _on_another_bore(pmi, geo, what: str, h, faces) -> bool:
+    """Whether ``what`` sits on a bore of hole ``h`` other than the entry bore the cell
+    measures (a counterbore's through bore); if so it is listed in ``pmi.unmodelled``."""
+    bore = geo.bore_of(h, faces)
+    if bore is None or abs(bore - h.diameter_m) <= SAME_SIZE_M:
+        return False
+    pmi.unmodelled.append(
+        f"{what} on {h.id}: on its {bore * 1e3:g} mm bore, the cell measures the "
+        f"{h.diameter_m * 1e3:g} mm entry bore"
+    )
+    return True
