@@ -8,7 +8,8 @@ from pathlib import Path
 DESCRIPTION = (
     "Surveys the cell's reference markers (docs/referencing.md): plans the survey tour (views "
     "converging on every hole group's markers at two distances, the table's markers, overview "
-    "views; each view turned about its axis until the arm reaches it), runs it on the "
+    "views; each view turned about its axis until the arm reaches it; of those, the fewest "
+    "that see every marker in 6 stereo views from rays 35 deg apart), runs it on the "
     "controller at --port, detects and identifies the markers in both images of the head at "
     "--camera, and solves one bundle adjustment (GTSAM) of the markers, every view's pose, the "
     "head self-calibrated and the scale bars. Writes OUT (markers.json: positions, covariance, "
