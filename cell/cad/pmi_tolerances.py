@@ -98,10 +98,8 @@ def tolerance(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi, capped: set[st
         pmi.unmodelled.append(f"{what} (not modelled: the cell evaluates position and size)")
         return
     faces = geo.of(lab)
-    on = holes_of(faces, holes)
+    on = _holes_or_listed(pmi, what, faces, holes)
     if not on:
-        where = f"on {len(faces)} faces, none a hole's wall" if faces else "attached to no face"
-        pmi.unmodelled.append(f"{what} ({where})")
         return
     holes_on = ", ".join(h.id for h in on)
     why = _zone_problem(obj) or "; ".join(ref_problems)
@@ -159,10 +157,8 @@ def dimension(lab, geo: PmiFaces, holes: list[CadHole], pmi: Pmi) -> None:
         f"{lower_mm - nominal_mm:+.6g}"
     )
     faces = geo.of(lab)
-    on = holes_of(faces, holes)
+    on = _holes_or_listed(pmi, what, faces, holes)
     if not on:
-        where = f"on {len(faces)} faces, none a hole's wall" if faces else "attached to no face"
-        pmi.unmodelled.append(f"{what} ({where})")
         return
     for h in on:
         if _on_another_bore(pmi, geo, what, h, faces):
@@ -199,3 +195,13 @@ def _on_another_bore(pmi, geo, what: str, h, faces) -> bool:
         f"{h.diameter_m * 1e3:g} mm entry bore"
     )
     return True
+
+
+def _holes_or_listed(pmi, what: str, faces, holes):
+    """The holes whose walls ``faces`` are; none: ``what`` is listed in ``pmi.unmodelled``
+    with where it sits instead."""
+    on = holes_of(faces, holes)
+    if not on:
+        where = f"on {len(faces)} faces, none a hole's wall" if faces else "attached to no face"
+        pmi.unmodelled.append(f"{what} ({where})")
+    return on

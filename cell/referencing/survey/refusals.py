@@ -70,13 +70,13 @@ def check_network(views: list[MarkerView], marker_ids: list[str], nominal: np.nd
                 f"deg at most, {math.degrees(MIN_INTERSECTION_RAD):.0f} deg "
                 "needed",
             )
-    pieces = _pieces(seen_by, len(views))
+    pieces = network_pieces(seen_by, len(views))
     if len(pieces) > 1:
         names = ", ".join(f"{{{marker_ids[p[0]]}, ... {len(p)} markers}}" for p in pieces[:3])
         raise SurveyRefusedError("network", f"in {len(pieces)} pieces that no view links: {names}")
 
 
-def _pieces(seen_by: list[list[int]], n_views: int) -> list[list[int]]:
+def network_pieces(seen_by: list[list[int]], n_views: int) -> list[list[int]]:
     """Markers grouped by the connected pieces of the view-marker graph."""
     parent = list(range(len(seen_by) + n_views))
 

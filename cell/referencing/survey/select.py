@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from cell.config import CellConfig
 from cell.config.markers import marker_in_cell
+from cell.referencing.survey.refusals import network_pieces
 from cell.referencing.visibility import seen_each
 from measure import StereoCalibration
 
@@ -54,25 +55,11 @@ def _rays(centres: Array, positions: Array) -> Array:
     return d / np.linalg.norm(d, axis=2, keepdims=True)
 
 
-def _pieces(chosen: list[int], sees: NDArray[np.bool_]) -> list[set[int]]:
-    """The markers seen by ``chosen`` grouped into the pieces the views link."""
-    parent = list(range(sees.shape[1]))
-
-    def find(a: int) -> int:
-        while parent[a] != a:
-            parent[a] = parent[parent[a]]
-            a = parent[a]
-        return a
-
-    for v in chosen:
-        ms = np.flatnonzero(sees[v])
-        for m in ms[1:]:
-            parent[find(int(m))] = find(int(ms[0]))
-    seen_any = np.flatnonzero(sees[chosen].any(axis=0)) if chosen else np.array([], int)
-    groups: dict[int, set[int]] = {}
-    for m in seen_any:
-        groups.setdefault(find(int(m)), set()).add(int(m))
-    return list(groups.values())
+def _pieces(chosen: list[int], sees: NDArray[np.bool_]) -> list[list[int]]:
+    """The markers seen by ``chosen`` grouped into the pieces the views link
+    (:func:`cell.referencing.survey.refusals.network_pieces`)."""
+    seen_by = [list(np.flatnonzero(sees[chosen, m])) for m in range(sees.shape[1])]
+    return [p for p in network_pieces(seen_by, len(chosen)) if seen_by[p[0]]]
 
 
 def select_views(

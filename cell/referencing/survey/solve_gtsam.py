@@ -100,7 +100,7 @@ def _priors(graph: gtsam.NonlinearFactorGraph, problem: SurveyProblem) -> None:
 
 
 def _graph(
-    problem: SurveyProblem, tie_sigma: float = RIG_TIE_SIGMA, robust: bool = False
+    problem: SurveyProblem, robust: bool = False
 ) -> tuple[gtsam.NonlinearFactorGraph, gtsam.Values]:
     graph = gtsam.NonlinearFactorGraph()
     values = gtsam.Values()
@@ -112,7 +112,7 @@ def _graph(
         pose = X(v) if s == 0 else Y(v)
         uv = problem.uv[k].reshape(2, 1)
         graph.add(gtsam.GeneralSFMFactor2Cal3DS2(uv, pix, pose, L(j), C(s)))
-    tie = gtsam.noiseModel.Isotropic.Sigma(6, tie_sigma)
+    tie = gtsam.noiseModel.Isotropic.Sigma(6, RIG_TIE_SIGMA)
     for v in range(problem.n_views):
         graph.add(gtsam.CustomFactor(tie, [X(v), Y(v), R(0)], _rig_error))
         values.insert(X(v), gtsam.Pose3(problem.poses0[v]))
