@@ -223,3 +223,37 @@ def test_a_corner_off_the_plate_plane_is_refined_again() -> None:
     assert off[0] > 5.0 and np.delete(off, 0).max() < 1.0
     fixed, why = repair_outliers(r.left, bad, spec, st.K_left, st.dist_left)
     assert why == "" and np.linalg.norm(fixed[0] - good[0]) < 0.5
+
+
+def test_views_detected_in_workers_equal_views_detected_in_this_process(small: dict) -> None:
+    """The simulated head's snapshots rendered and detected in 2 worker processes give the
+    features one process gives, view by view, in the tour's order."""
+    from cell.calibration.capture import CaptureSettings, TourCapture, check_calibration_tour
+    from cell.link.client import ControllerClient
+    from planner.calibration import load_caltour
+
+    cell = load_cell(small["cell"])
+    tour = load_caltour(small["tours"][12])
+    spec = check_calibration_tour(cell, tour, "test tour")
+    views = {}
+    for workers in (0, 2):
+        opts = WorldOptions(speed=20.0, drift_offset_s=STEADY_S, truth=CellTruth.drawn(0))
+        with SimCell.start(cell, opts) as sim:
+            client = ControllerClient(sim.url)
+            client.connect()
+            try:
+                settings = CaptureSettings(settle_s=0.0, workers=workers)
+                cap = TourCapture(tour.tour, client, sim.camera, spec, settings).run()
+            finally:
+                client.close()
+        views[workers] = cap.views
+        assert cap.wall_s["cpu_s"] > 0.0 and cap.wall_s["render_s"] > 0.0  # snapshots
+    assert (
+        [v.id for v in views[0]] == [v.id for v in views[2]] == [s.hole_id for s in tour.tour.stops]
+    )
+    for a, b in zip(views[0], views[2], strict=True):
+        np.testing.assert_array_equal(a.q_rad, b.q_rad)
+        for pa, pb in ((a.corners_left_px, b.corners_left_px),
+                       (a.corners_right_px, b.corners_right_px)):  # fmt: skip
+            assert pa is not None and pb is not None
+            np.testing.assert_array_equal(pa, pb)

@@ -136,6 +136,11 @@ def test_link_loss_stops_the_arm_on_the_path(controller: str) -> None:
         c.move_to_stop(0)
         c._stop_hb.set()
         time.sleep(0.3)
+        if controller == "python":  # a status request would feed the watchdog: wait without
+            # one until the simulator's loop has run (it may not have, on a loaded machine)
+            deadline = time.monotonic() + 30.0
+            while sim.controller.s.state == m.State.MOVING and time.monotonic() < deadline:
+                time.sleep(0.05)
         st = c.status()
         assert st.state == m.State.STOPPED and st.fault == m.Fault.LINK_LOST
         assert 0 < st.row < n - 50

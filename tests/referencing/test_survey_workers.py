@@ -9,8 +9,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from cell.camera.workers import executor
 from cell.config.markers import marker_codes, marker_in_cell
-from cell.referencing.survey.capture import _executor, observe_view
+from cell.referencing.survey.capture import observe_view
 from cell.referencing.survey.plan import survey_views
 from cell.sim.camera import SimCamera
 from cell.sim.truth import CellTruth
@@ -73,7 +74,7 @@ def test_views_from_worker_processes_equal_views_from_this_process(scenes, small
     snaps = [(vid, T, cam.snapshot()) for vid, T, cam in scenes]
     pairs = [(vid, T, s()) for vid, T, s in snaps]  # a camera without snapshots sends pairs
     for workers, sources in ((0, snaps), (2, snaps), ("2, pairs", pairs)):
-        with _executor(2 if workers else 0) as pool:
+        with executor(2 if workers else 0) as pool:
             jobs = [pool.submit(observe_view, s, stereo, codes, geometry, vid, T)
                     for vid, T, s in sources]  # fmt: skip
             results[workers] = [job.result()[0] for job in jobs]

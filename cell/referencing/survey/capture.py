@@ -7,26 +7,31 @@ within a budget, stop safely on a fault). Each view's prior is its planned left-
 adjustment.
 
 The views' detections run in ``workers`` processes while the arm moves on (the survey's images
-are many: on two cores, two at a time). A camera that can take a snapshot (the simulated head:
-``snapshot()`` returns a picklable function that renders the pair it saw) has its pairs
-rendered there too, so the arm never waits for a render. The views are collected in the tour's
-order, and a view's result depends only on its images: the same captures give the same views
-with any number of workers (``workers=0``: in this process, one view after another).
+are many: on two cores, two at a time), the simulated head's renders too
+(:mod:`cell.camera.workers`), so the arm never waits for a render. The views are collected
+in the tour's order, and a view's result depends only on its images: the same captures give the
+same views with any number of workers (``workers=0``: in this process, one view after another).
 """
 
 from __future__ import annotations
 
 import logging
-import multiprocessing
 import time
 from collections import deque
 from collections.abc import Callable, Mapping
-from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from cell.camera import CameraBackend, StereoPair
+from cell.camera import CameraBackend
+from cell.camera.workers import (
+    PAIRS_WAITING_PER_WORKER,
+    PairSource,
+    executor,
+    pair_source,
+    rendered,
+)
 from cell.config import CellConfig
 from cell.config.markers import marker_codes, marker_in_cell
 from cell.link.client import ControllerClient
@@ -37,9 +42,6 @@ from cell.referencing.survey.tour import SurveyTour
 from measure import StereoCalibration
 
 log = logging.getLogger(__name__)
-
-#: captured pairs (5 MP each) that may wait for a worker before the arm waits for them
-PAIRS_WAITING_PER_WORKER = 2
 
 #: ``progress(event, data)``: "view" after each view (``k``, ``n``, ``id``, ``markers``)
 Progress = Callable[[str, dict], None]
@@ -123,8 +125,7 @@ class SurveyCapture(Motion):
         t_start = self._call("status", self.client.status).time_s
         n = len(tour.stops)
         views: list[MarkerView] = []
-        snapshot = getattr(self.camera, "snapshot", None)
-        pool = _executor(self.options.workers)
+        pool = executor(self.options.workers)
         try:
             pending: deque[Future] = deque()
             for k, stop in enumerate(tour.stops):
@@ -133,7 +134,7 @@ class SurveyCapture(Motion):
                 self._settled_status()
                 wall["move_s"] += time.perf_counter() - t
                 t = time.perf_counter()
-                source = snapshot() if snapshot is not None else self.camera.capture()
+                source, is_pair = pair_source(self.camera)
                 wall["capture_s"] += time.perf_counter() - t
                 pending.append(pool.submit(observe_view, source, self.stereo, self.codes,
                                            self.geometry, stop.hole_id,
@@ -142,7 +143,7 @@ class SurveyCapture(Motion):
                 while pending and pending[0].done():  # in the tour's order
                     self._collect(views, pending.popleft(), n, wall)
                 # pairs (not snapshots) wait in memory: the arm waits when too many do
-                if snapshot is None and len(pending) > PAIRS_WAITING_PER_WORKER * max(
+                if is_pair and len(pending) > PAIRS_WAITING_PER_WORKER * max(
                     self.options.workers, 1
                 ):
                     self._collect(views, pending.popleft(), n, wall)
@@ -167,29 +168,8 @@ class SurveyCapture(Motion):
                                "markers": len(view.both())})  # fmt: skip
 
 
-class _InProcess(Executor):
-    """Runs each job at once, in this process (``workers=0``)."""
-
-    def submit(self, fn, /, *args, **kwargs) -> Future:  # type: ignore[override]
-        future: Future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except Exception as exc:  # handed to the caller by result()
-            future.set_exception(exc)
-        return future
-
-
-def _executor(workers: int) -> Executor:
-    """``workers`` processes started by a fork server (a process that runs a simulator holds
-    threads whose locks a forked child would inherit locked), or this process."""
-    if workers <= 0:
-        return _InProcess()
-    ctx = multiprocessing.get_context("forkserver")
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
-
-
 def observe_view(
-    source: StereoPair | Callable[[], StereoPair],
+    source: PairSource,
     stereo: StereoCalibration,
     codes: Mapping[int, str],
     geometry: MarkerGeometry,
@@ -199,8 +179,8 @@ def observe_view(
     """One view's markers (:func:`observe_pair`) from its pair, or from a snapshot that renders
     it (``source()``); and the wall time of the render and the detection and their CPU time (s)."""
     t, c = time.perf_counter(), time.thread_time()
-    pair = source if isinstance(source, StereoPair) else source()
-    render_s = 0.0 if isinstance(source, StereoPair) else time.perf_counter() - t
+    pair, was_rendered = rendered(source)
+    render_s = time.perf_counter() - t if was_rendered else 0.0
     t = time.perf_counter()
     view = observe_pair(pair.left, pair.right, stereo, codes, geometry, view_id,
                         T_cell_left_prior)  # fmt: skip
