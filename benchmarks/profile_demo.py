@@ -11,8 +11,11 @@ their wall and CPU time, summed over the views, are the workers' own figures
 (``survey: render (workers)``, ``survey: detect (workers)``); the capture loop's wall is the
 stage the survey's wall time is made of (``survey: tour driven``).
 
-The camera's renders are split by phase (calibration, survey, run: the reference rounds and
-the holes), and so is the marker detection (the reference rounds' and the holes').
+The calibration tour renders and detects its views in worker processes as the survey does (its
+walls: ``calibration tour walls``); the run renders each stop's pair in a worker while it
+measures the stop before (its wait for a pair: ``render_s`` of the holes' laps). Renders left in
+this process are split by phase, and so is the marker detection (the reference rounds' and the
+holes').
 
 Targets (issue 27): the demo in ≤ 60 s wall on the 2-core machine. On a shared machine
 wall times include waiting for a CPU; the load average is printed.

@@ -117,7 +117,7 @@ class DemoOptions:
     calibrate: bool = True
     calibration_views: int = 120
     calibration_method: str = "images"
-    calibration_speed: float = 20.0
+    calibration_speed: float = 10.0
     referencing: bool = True
     survey_speed: float = 20.0
     thermal_scale: float = 1.0

@@ -4,10 +4,13 @@ thermal model identified from them (:class:`cell.run.runner.Runner`'s base)."""
 from __future__ import annotations
 
 import time
+from concurrent.futures import Future
 
 import numpy as np
 
+from cell.camera.backend import computing
 from cell.camera.errors import PairError
+from cell.link import messages as m
 from cell.link.motion import Motion
 from cell.referencing.detection import detect_pair, label_circles
 from cell.run.reference import target_of
@@ -22,8 +25,8 @@ HOME_TOL_RAD = float(np.deg2rad(0.5e-3))
 
 class ReferencePhase(Motion):
     """The reference rounds and the thermal identification; uses the runner's ``tour``,
-    ``reference_tour``, ``camera``, ``stereo``, ``codes``, ``thermal``, ``store``, ``options``,
-    ``progress``, ``model`` and ``model_id``."""
+    ``reference_tour``, ``camera``, ``ahead`` (its captures), ``stereo``, ``codes``,
+    ``thermal``, ``store``, ``options``, ``progress``, ``model`` and ``model_id``."""
 
     def _home_for_reference(self) -> None:
         """Bring the arm home if it is elsewhere (a resumed run stopped at a hole, between holes
@@ -51,28 +54,42 @@ class ReferencePhase(Motion):
                 self.thermal.cold_degC = tuple(float(v) for v in st_start.temperatures_c)
                 self.store.set_thermal_reference(self.thermal.cold_degC)
             self.progress("round", {"round": rnd, "time_s": t_start})
+            pending = None  # the view captured, measured once the arm waits at the next one
             for k, s in enumerate(tour.stops):
                 self._move(k, f"reference {s.hole_id}")
                 st = self._settled_status()
-                try:
-                    pair = self.camera.capture()
-                    exclude = None
-                    if self.codes:  # the markers' labels are not the reference target
-                        dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
-                        exclude = label_circles(dets)
-                    meas = measure_hole(pair.left, pair.right, self.stereo, exclude=exclude)
-                except (MeasurementError, PairError) as exc:
-                    self.store.event("reference", f"{s.hole_id}: not measured: {exc}")
-                    continue
-                p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
-                target = target_of(s.hole_id)
-                row = (st.time_s, target, st.q_rad, st.temperatures_c, p_tcp, self._round0 + rnd)
-                self.store.record_reference(row[5], *row[:5])
-                self.thermal.add(*row)
-                self.progress("reference", {"round": rnd, "target": s.hole_id})
+                last, pending = (
+                    pending,
+                    (rnd, s.hole_id, st, self.ahead.capture(k, s.hole_id, keep=False)),
+                )
+                if last is not None:
+                    self._reference_view(*last)
+            if pending is not None:
+                self._reference_view(*pending)
             self._move(len(tour.stops), "reference home")
             if rnd + 1 < self.options.reference_rounds:
                 self._wait_controller_time(t_start + self.options.reference_interval_s)
+
+    def _reference_view(self, rnd: int, view_id: str, st: m.Status, pair: Future) -> None:
+        """Measure one reference view's target (the pair to come, :mod:`cell.run.ahead`) and
+        record it, or record why not."""
+        with computing(self.camera):  # the arm waits while the computer works
+            try:
+                pair, _ = pair.result()
+                exclude = None
+                if self.codes:  # the markers' labels are not the reference target
+                    dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
+                    exclude = label_circles(dets)
+                meas = measure_hole(pair.left, pair.right, self.stereo, exclude=exclude)
+            except (MeasurementError, PairError) as exc:
+                self.store.event("reference", f"{view_id}: not measured: {exc}")
+                return
+        p_tcp = self._T_head_left[:3, :3] @ meas.center_m + self._T_head_left[:3, 3]
+        row = (st.time_s, target_of(view_id), st.q_rad, st.temperatures_c, p_tcp,
+               self._round0 + rnd)  # fmt: skip
+        self.store.record_reference(row[5], *row[:5])
+        self.thermal.add(*row)
+        self.progress("reference", {"round": rnd, "target": view_id})
 
     def _wait_controller_time(self, t_s: float) -> None:
         while self._call("status", self.client.status).time_s < t_s:

@@ -15,7 +15,10 @@ import logging
 import sqlite3
 import time
 from collections.abc import Callable
+from concurrent.futures import Future
+from contextlib import closing
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -26,6 +29,7 @@ from cell.camera.errors import PairError
 from cell.config import CellConfig
 from cell.config.markers import marker_codes
 from cell.errors import CellError
+from cell.link import messages as m
 from cell.link.client import ControllerClient
 from cell.link.errors import LinkError, RunFaultError
 from cell.records.hole_result import HoleResult
@@ -33,6 +37,7 @@ from cell.referencing.detection import detect_pair, label_circles
 from cell.referencing.network import MarkerNetwork
 from cell.review.audit_images import save_pair
 from cell.review.store import Store
+from cell.run.ahead import PairsAhead
 from cell.run.inspect import T_cell_tcp, inspect_hole, uncaptured_hole
 from cell.run.reference_phase import ReferencePhase
 from cell.run.referenced import ArmRegistration, LocatedStop, locate_stop, located_note
@@ -85,8 +90,9 @@ class RunOptions:
 @dataclass
 class RunResult:
     """Outcome of :meth:`Runner.run`: status (``done`` / ``fault``), holes stored by this call,
-    holes skipped as already stored, timings (s; per hole: move, settle, capture, inspect (of it
-    the measurement itself: measure_s), store, record) and link counters."""
+    holes skipped as already stored, timings (s; per hole: move, settle, capture (the trigger),
+    render (the wait for a simulated pair still rendering), locate, inspect (of it the
+    measurement itself: measure_s), store, record) and link counters."""
 
     status: str
     stored: list[HoleResult] = field(default_factory=list)
@@ -187,6 +193,12 @@ class Runner(ReferencePhase):
             wait_for_start()
         todo = [k for k, s in enumerate(self.tour.stops) if s.hole_id not in stored]
         result.skipped = [s.hole_id for s in self.tour.stops if s.hole_id in stored]
+        keep_dir = self.store.path.parent if self.options.keep_images else None
+        with closing(PairsAhead(self.camera, keep_dir)) as self.ahead:
+            self._stops(todo, result)
+
+    def _stops(self, todo: list[int], result: RunResult) -> None:
+        """The reference phase, then every stop of ``todo``."""
         if todo and self.reference_tour is not None and self.options.reference_rounds > 0:
             self._state("reference")
             self._home_for_reference()
@@ -195,10 +207,25 @@ class Runner(ReferencePhase):
         self.budget = self._budget_context()  # after the cold readings: no delay before them
         self._state("inspecting")
         self._load(self.tour)
-        for k in todo:
-            hole, laps = self._inspect_stop(k)
-            result.stored.append(hole)
-            result.hole_timings.append(laps)
+        pending = None  # the stop captured, measured once the arm waits at the next one
+        try:
+            for k in todo:
+                last, pending = pending, self._capture_stop(k)
+                if last is not None:
+                    self._finish_stop(last, result)
+            if pending is not None:
+                pending, last = None, pending
+                self._finish_stop(last, result)
+        except KeyboardInterrupt:  # the operator stops the run now (a resume measures the rest)
+            raise
+        except BaseException:
+            if pending is not None:  # captured before the fault: measured and stored
+                try:
+                    self._finish_stop(pending, result)
+                except Exception as exc:  # the fault is what the run reports
+                    log.error("stop %d could not be measured after the fault: %s",
+                              pending[0], exc)  # fmt: skip
+            raise
         self._state("homing")
         self._move(len(self.tour.stops), "home")
         self.store.set_state("done", finished=True)
@@ -296,24 +323,37 @@ class Runner(ReferencePhase):
             log.warning("%s", note[1])
 
     # --- one hole --------------------------------------------------------------------------
-    def _inspect_stop(self, k: int) -> tuple[HoleResult, dict[str, float]]:
-        """Move, settle, capture, measure, compensate, compare, store, record one stop; returns
-        the result and the wall time (s) of each step."""
+    def _capture_stop(self, k: int) -> tuple[int, Any, m.Status, _Laps, Future]:
+        """Move, settle and capture stop ``k``: its index, stop, status, laps and pair to come
+        (:class:`cell.run.ahead.PairsAhead`)."""
         stop = self.tour.stops[k]
         clock = _Laps()
         self._move(k, f"stop {k} ({stop.hole_id})")
         clock.lap("move_s")
         st = self._settled_status()
         clock.lap("settle_s")
-        try:
-            pair = self.camera.capture()
-        except PairError as exc:  # no pair of one trigger: this stop fails, the run goes on
-            return self._uncaptured(k, stop.hole_id, exc, st, clock)
+        pair = self.ahead.capture(k, stop.hole_id)
         clock.lap("capture_s")
-        with computing(self.camera):  # the arm waits at its stop while the computer works
-            return self._process_pair(k, stop, pair, st, clock)
+        return k, stop, st, clock, pair
 
-    def _process_pair(self, k: int, stop, pair, st, clock: _Laps
+    def _finish_stop(self, captured: tuple[int, Any, m.Status, _Laps, Future],
+                     result: RunResult) -> None:  # fmt: skip
+        """Measure, compensate, compare, store, record a captured stop; add it to ``result``
+        with the wall time (s) of each step."""
+        k, stop, st, clock, future = captured
+        with computing(self.camera):  # the arm waits at its stop while the computer works
+            clock.skip()  # the next stop's move and capture: that stop's laps
+            try:
+                pair, kept = future.result()
+            except PairError as exc:  # no pair of one trigger: this stop fails, the run goes on
+                hole, laps = self._uncaptured(k, stop.hole_id, exc, st, clock)
+            else:
+                clock.lap("render_s")
+                hole, laps = self._process_pair(k, stop, pair, st, clock, kept)
+        result.stored.append(hole)
+        result.hole_timings.append(laps)
+
+    def _process_pair(self, k: int, stop, pair, st, clock: _Laps, kept: bool
                       ) -> tuple[HoleResult, dict[str, float]]:  # fmt: skip
         """Locate, measure, compensate, compare, store and record stop ``k``'s pair."""
         T_arm = (T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
@@ -343,7 +383,7 @@ class Runner(ReferencePhase):
         result = replace(result, thermal_model_id=self.model_id if self.model else None)
         clock.lap("inspect_s")
         self.store.record_hole(result)
-        if self.options.keep_images:  # for audit and holecell remeasure
+        if self.options.keep_images and not kept:  # for audit and holecell remeasure
             save_pair(self.store.path.parent, k, stop.hole_id, pair.left, pair.right)
         clock.lap("store_s")
         if self.recorder is not None:
@@ -357,7 +397,7 @@ class Runner(ReferencePhase):
     def _uncaptured(self, k: int, hole_id: str, exc: PairError, st, clock: _Laps
                     ) -> tuple[HoleResult, dict[str, float]]:  # fmt: skip
         """Store stop ``k`` as unmeasured with the camera's reason (a resume retries it)."""
-        clock.lap("capture_s")
+        clock.lap("render_s")
         result = uncaptured_hole(self.cell, self.holes[hole_id], k, exc.reason, st.q_rad,
                                  st.temperatures_c, st.time_s)  # fmt: skip
         self.store.event("camera", f"stop {k} ({hole_id}): {exc}")
@@ -374,3 +414,7 @@ class _Laps:
     def lap(self, name: str) -> None:
         t = time.perf_counter()
         self.laps[name], self._t = t - self._t, t
+
+    def skip(self) -> None:
+        """Start the next lap now: the time since the last one is nobody's."""
+        self._t = time.perf_counter()

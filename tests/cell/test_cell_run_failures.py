@@ -28,16 +28,21 @@ WORLD = WorldOptions(speed=50.0, drift=steady_drift())
 
 
 def _fail_on_capture(sim: SimCell, n_ok: int) -> None:
-    """Make the simulated head fail after ``n_ok`` good captures."""
-    real, calls = sim.camera.capture, []
+    """Make the simulated head fail after ``n_ok`` good captures (or snapshots: the runner
+    renders the simulated head's pairs in a worker)."""
+    calls = []
 
-    def capture():
-        calls.append(1)
-        if len(calls) > n_ok:
-            raise CameraError("sim head", "the strobe did not fire")
-        return real()
+    def failing(real):
+        def trigger():
+            calls.append(1)
+            if len(calls) > n_ok:
+                raise CameraError("sim head", "the strobe did not fire")
+            return real()
 
-    sim.camera.capture = capture
+        return trigger
+
+    sim.camera.capture = failing(sim.camera.capture)
+    sim.camera.snapshot = failing(sim.camera.snapshot)
 
 
 def _run(sc: SmallCell, run_dir: Path, sim: SimCell, progress=None) -> None:
