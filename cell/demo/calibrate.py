@@ -118,11 +118,11 @@ def calibrate_demo_cell(
     return DemoCalibration(path, res.calibration, seconds, dp, dr, fixed, method)
 
 
-def plan_demo_caltour(views: int, seed: int) -> dict:
+def plan_demo_caltour(views: int, seed: int, cached_only: bool = False) -> dict | None:
     """The built-in cell's calibration tour as ``holecell calibrate cell`` plans it (JSON-ready:
     planned in a worker process), planned once per cell, view count, seed and code and then
     read from the user's cache folder (:mod:`cell.demo.caltour_cache`; its ``settings``
-    key ``plan_cache`` says which)."""
+    key ``plan_cache`` says which); ``cached_only``: None when it is not cached."""
     from cell.calibration.plan import calibrate_plan_options, plan_cell_calibration
     from cell.camera import cell_stereo
     from cell.config import load_builtin_cell
@@ -130,10 +130,14 @@ def plan_demo_caltour(views: int, seed: int) -> dict:
     cell = load_builtin_cell()
     opts = replace(calibrate_plan_options(views, seed), criterion=CALTOUR_CRITERION,
                    predict=False)  # fmt: skip
-    data, note = cached_caltour(
+    found = cached_caltour(
         caltour_key(cell, opts, views, seed),
-        lambda: plan_cell_calibration(cell, cell_stereo(cell), opts).to_dict(),
-    )
+        None if cached_only else lambda: plan_cell_calibration(cell, cell_stereo(cell),
+                                                               opts).to_dict(),
+    )  # fmt: skip
+    if found is None:
+        return None
+    data, note = found
     data.setdefault("settings", {})["plan_cache"] = note  # printed with the calibration
     return data
 

@@ -70,23 +70,24 @@ def plan_key(what: dict[str, Any], packages: tuple[str, ...] = _CODE) -> str:
 
 
 def cached_caltour(
-    key: str, plan: Callable[[], dict[str, Any]], folder: Path | None = None
-) -> tuple[dict[str, Any], str]:
+    key: str, plan: Callable[[], dict[str, Any]] | None, folder: Path | None = None
+) -> tuple[dict[str, Any], str] | None:
     """The calibration tour (``caltour.json`` mapping) for ``key``: read from the cache, else
-    ``plan()`` and stored. Returns it and a sentence saying which."""
+    ``plan()`` and stored (``plan`` None: None). Returns it and a sentence saying which."""
     return cached_plan("caltour", key, plan, caltour_from_dict, folder)
 
 
 def cached_plan(
     name: str,
     key: str,
-    plan: Callable[[], dict[str, Any]],
+    plan: Callable[[], dict[str, Any]] | None,
     check: Callable[[dict[str, Any], str], Any],
     folder: Path | None = None,
-) -> tuple[dict[str, Any], str]:
+) -> tuple[dict[str, Any], str] | None:
     """A planned mapping for ``key``, kept as ``<name>-<key>.json``: read from the cache (and
     ``check(data, path)``: raises :class:`PlanningError` or ValueError when it is not one),
-    else ``plan()`` and stored. Returns it and a sentence saying which."""
+    else ``plan()`` and stored (``plan`` None: None, nothing planned). Returns it and a
+    sentence saying which."""
     path = (folder or cache_dir()) / f"{name}-{key[:24]}.json"
     if path.is_file():
         try:
@@ -101,6 +102,8 @@ def cached_plan(
             stale = f" (the cached file did not read back: {exc})"
     else:
         stale = ""
+    if plan is None:
+        return None
     t0 = time.perf_counter()
     data = plan()
     took = time.perf_counter() - t0

@@ -10,11 +10,8 @@ truth, the result also holds the measurement error against it, with and without 
 
 from __future__ import annotations
 
-import logging
-import multiprocessing
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -22,27 +19,22 @@ from typing import Any
 import numpy as np
 
 from cell.calibration.use import RunCalibration, load_run_calibration
-from cell.camera import cell_stereo
 from cell.config import CellConfig, load_builtin_cell
 from cell.demo.calibrate import (
     DemoCalibration,
     calibrate_demo_cell,
     calibrate_demo_cell_images,
-    plan_demo_caltour,
 )
+from cell.demo.plan import plan_demo
 from cell.demo.survey import (
     DemoSurvey,
-    plan_demo_survey,
     survey_demo_cell,
-    survey_tour_from_dict,
 )
 from cell.demo.truth_error import DatumError, TruthError, datum_truth_error, truth_error
 from cell.link.client import ControllerClient
 from cell.referencing.network import MarkerNetwork, load_network
 from cell.referencing.survey.tour import SurveyTour
-from cell.referencing.viewpoints import MarkerAwarePlanner
 from cell.review.report import write_report
-from cell.run.reference import plan_reference_tour
 from cell.run.runner import Progress, Runner, RunOptions, RunResult
 from cell.run.setup import RunFiles, check_new_run_dir, start_run
 from cell.sim.faults import FaultPlan
@@ -51,9 +43,8 @@ from cell.sim.truth import CellTruth
 from cell.sim.world import WorldOptions
 from cell.uncertainty.decision import DEFAULT_RULE
 from cell.uncertainty.repeatability import repeatability_rp_m
-from planner import Options, Tour, TourPlanner
-from planner.calibration import CalibrationTour, caltour_from_dict
-from planner.tour import tour_from_dict
+from planner import Tour
+from planner.calibration import CalibrationTour
 from robots.thermal.drift import DriftSettings, WarmUp, default_settings
 
 
@@ -144,45 +135,6 @@ class DemoResult:
     datum: DatumError | None = None
     calibration: DemoCalibration | None = None
     survey: DemoSurvey | None = None
-
-
-def _plan_reference(seed: int) -> dict[str, Any]:
-    # views the arm cannot reach are expected; the tour lists them in left_out
-    logging.getLogger("planner").setLevel(logging.ERROR)
-    return plan_reference_tour(load_builtin_cell(), Options(seed=seed)).to_dict()
-
-
-def plan_demo(
-    cell: CellConfig,
-    seed: int,
-    plan_progress: Callable[[str, int, int], None] | None = None,
-    caltour_views: int = 0,
-    survey: bool = False,
-) -> tuple[Tour, Tour, CalibrationTour | None, SurveyTour | None]:
-    """The hole tour, the reference tour, (``caltour_views`` > 0) the calibration tour and
-    (``survey``) the survey tour of ``cell``; the others are planned in worker processes while
-    this one plans the holes.
-    The workers are started by a fork server, not forked from this one: a process that has
-    run a simulator or a planner holds threads (and their locks) that a forked child would
-    inherit locked."""
-    ctx = multiprocessing.get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
-        ref_job = pool.submit(_plan_reference, seed)
-        cal_job = pool.submit(plan_demo_caltour, caltour_views, seed) if caltour_views else None
-        survey_job = pool.submit(plan_demo_survey, seed) if survey else None
-        tour = (
-            MarkerAwarePlanner(cell, cell_stereo(cell), Options(seed=seed), plan_progress)
-            if survey
-            else TourPlanner(Options(seed=seed), plan_progress)
-        ).plan(cell)
-        reference = tour_from_dict(ref_job.result(), "reference tour")
-        if cal_job is not None and plan_progress is not None:  # may still be planning
-            plan_progress("calibration tour", int(cal_job.done()), 1)
-        caltour = None if cal_job is None else caltour_from_dict(cal_job.result(), "caltour")
-        planned = None if survey_job is None else survey_tour_from_dict(survey_job.result())
-        if cal_job is not None and plan_progress is not None:
-            plan_progress("calibration tour", 1, 1)
-    return tour, reference, caltour, planned
 
 
 def run_demo(

@@ -48,10 +48,11 @@ class DemoSurvey:
 SURVEY_PLAN_CODE = ("planner", "robots", "cell/referencing", "cell/demo", "cell/config")
 
 
-def plan_demo_survey(seed: int) -> dict:
+def plan_demo_survey(seed: int, cached_only: bool = False) -> dict | None:
     """The built-in cell's survey tour as ``holecell survey`` plans it (JSON-ready: planned in a
     worker process), planned once per cell, seed and code and then read from the user's cache
-    folder (:mod:`cell.demo.caltour_cache`; ``plan_cache`` says which)."""
+    folder (:mod:`cell.demo.caltour_cache`; ``plan_cache`` says which); ``cached_only``: None
+    when it is not cached."""
     from cell.camera import cell_stereo
     from cell.config import load_builtin_cell
     from cell.referencing.survey.tour import plan_survey_tour
@@ -68,7 +69,11 @@ def plan_demo_survey(seed: int) -> dict:
 
     key = plan_key({"plan": "survey", "cell": cell_sha256(cell), "seed": seed},
                    SURVEY_PLAN_CODE)  # fmt: skip
-    data, note = cached_plan("survey", key, plan, lambda d, src: survey_tour_from_dict(d))
+    found = cached_plan("survey", key, None if cached_only else plan,
+                        lambda d, src: survey_tour_from_dict(d))  # fmt: skip
+    if found is None:
+        return None
+    data, note = found
     data["plan_cache"] = note
     return data
 

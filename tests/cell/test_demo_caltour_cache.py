@@ -67,3 +67,17 @@ def test_the_key_names_what_decides_the_plan(planned, monkeypatch, tmp_path) -> 
     assert len({key, caltour_key(cell, o, 6, 1), caltour_key(cell, o, 5, 2)}) == 3
     monkeypatch.setenv(CACHE_ENV, str(tmp_path))
     assert cache_dir() == tmp_path
+
+
+def test_the_cache_alone_is_read_without_planning(planned, tmp_path) -> None:
+    """``plan`` None (the demo looking before it starts a worker): None on a miss, nothing
+    planned or written; the cached tour once it is there."""
+    cell, o, plan, calls = planned
+    key = caltour_key(cell, o, 5, 1)
+    n0 = len(calls)
+    assert cached_caltour(key, None, tmp_path) is None
+    assert len(calls) == n0 and not list(tmp_path.iterdir())
+    first, _ = cached_caltour(key, plan, tmp_path)
+    again, note = cached_caltour(key, None, tmp_path)
+    assert len(calls) == n0 + 1 and note.startswith("from the cache") and again == json.loads(
+        json.dumps(first))  # fmt: skip
