@@ -31,18 +31,37 @@ from measure.target import TargetSpec, to_gray8
 Array = NDArray[np.float64]
 
 
-def _cell_mean(img: Array, grid: Array, i: int, j: int) -> float:
-    """Mean grey around the centre of the square between rows i, i+1 and columns j, j+1,
-    over a patch a quarter of the square's size."""
+def _cell_box(grid: Array, i: int, j: int, shape: tuple[int, ...]) -> tuple[int, int, int, int]:
+    """Rows and columns (``y0, y1, x0, x1``, clipped to the image) of a patch a quarter of the
+    square's size around the centre of the square between rows i, i+1 and columns j, j+1."""
     quad = grid[i : i + 2, j : j + 2].reshape(-1, 2)
     c = quad.mean(axis=0)
     half = max(1, int(0.125 * np.linalg.norm(grid[i, j] - grid[i + 1, j + 1])))
     x0, y0 = round(float(c[0])), round(float(c[1]))
-    h, w = img.shape[:2]
-    patch = img[
-        max(0, y0 - half) : min(h, y0 + half + 1), max(0, x0 - half) : min(w, x0 + half + 1)
-    ]
-    return float(patch.mean()) if patch.size else float("nan")
+    h, w = shape[:2]
+    return max(0, y0 - half), min(h, y0 + half + 1), max(0, x0 - half), min(w, x0 + half + 1)
+
+
+def _cell_means(gray8: NDArray, grid: Array, cells: list[tuple[int, int]]) -> list[float]:
+    """Mean grey of each cell's patch (:func:`_cell_box`) in the image blurred by a 3 x 3
+    Gaussian; only a crop around the patches is blurred, one pixel wider than they are on each
+    side (what the kernel reads), so the means are those of the whole image blurred."""
+    h, w = gray8.shape[:2]
+    boxes = [_cell_box(grid, i, j, gray8.shape) for i, j in cells]
+    y0 = max(0, min(b[0] for b in boxes) - 1)
+    y1 = min(h, max(b[1] for b in boxes) + 1)
+    x0 = max(0, min(b[2] for b in boxes) - 1)
+    x1 = min(w, max(b[3] for b in boxes) + 1)
+    if y1 <= y0 or x1 <= x0:
+        return [float("nan")] * len(cells)
+    # the crop's outermost pixels are in no patch unless they are the image's own border,
+    # which the crop reflects as the whole image does
+    crop = cv2.GaussianBlur(gray8[y0:y1, x0:x1], (3, 3), 0).astype(float)
+    out = []
+    for b in boxes:
+        patch = crop[b[0] - y0 : b[1] - y0, b[2] - x0 : b[3] - x0]
+        out.append(float(patch.mean()) if patch.size else float("nan"))
+    return out
 
 
 def orient_chessboard(gray: NDArray, points_px: Array, spec: TargetSpec) -> Array:
@@ -53,8 +72,7 @@ def orient_chessboard(gray: NDArray, points_px: Array, spec: TargetSpec) -> Arra
     along, down = grid[0, 1] - grid[0, 0], grid[1, 0] - grid[0, 0]
     if along[0] * down[1] - along[1] * down[0] < 0:
         grid = grid[::-1]
-    img = cv2.GaussianBlur(to_gray8(gray), (3, 3), 0).astype(float)
-    first, beside = _cell_mean(img, grid, 0, 0), _cell_mean(img, grid, 0, 1)
+    first, beside = _cell_means(to_gray8(gray), grid, [(0, 0), (0, 1)])
     if first > beside:
         grid = grid[::-1, ::-1]
     return grid.reshape(-1, 2).copy()
