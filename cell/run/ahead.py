@@ -9,6 +9,7 @@ its own pair, in the tour's order, so the results are those of one stop after an
 
 from __future__ import annotations
 
+import time
 from concurrent.futures import Executor, Future
 from pathlib import Path
 
@@ -59,3 +60,19 @@ def render_and_keep(
         return pair, False
     save_pair(keep_dir, stop_index, hole_id, pair.left, pair.right)
     return pair, True
+
+
+class Laps:
+    """The wall time of each step of a stop (s), lap by lap."""
+
+    def __init__(self) -> None:
+        self.laps: dict[str, float] = {}
+        self._t = time.perf_counter()
+
+    def lap(self, name: str) -> None:
+        t = time.perf_counter()
+        self.laps[name], self._t = t - self._t, t
+
+    def skip(self) -> None:
+        """Start the next lap now: the time since the last one is nobody's."""
+        self._t = time.perf_counter()

@@ -37,7 +37,7 @@ from cell.referencing.detection import detect_pair, label_circles
 from cell.referencing.network import MarkerNetwork
 from cell.review.audit_images import save_pair
 from cell.review.store import Store
-from cell.run.ahead import PairsAhead
+from cell.run.ahead import Laps, PairsAhead
 from cell.run.inspect import T_cell_tcp, inspect_hole, uncaptured_hole
 from cell.run.reference_phase import ReferencePhase
 from cell.run.referenced import ArmRegistration, LocatedStop, locate_stop, located_note
@@ -127,13 +127,8 @@ class Runner(ReferencePhase):
         base_from: str = "cell",
         markers: MarkerNetwork | None = None,
     ) -> None:
-        self.cell, self.tour, self.store, self.client, self.camera = (
-            cell,
-            tour,
-            store,
-            client,
-            camera,
-        )
+        self.cell, self.tour, self.store = cell, tour, store
+        self.client, self.camera = client, camera
         self.options = options or RunOptions()
         self.reference_tour = reference_tour
         self.model = thermal_model
@@ -323,11 +318,11 @@ class Runner(ReferencePhase):
             log.warning("%s", note[1])
 
     # --- one hole --------------------------------------------------------------------------
-    def _capture_stop(self, k: int) -> tuple[int, Any, m.Status, _Laps, Future]:
+    def _capture_stop(self, k: int) -> tuple[int, Any, m.Status, Laps, Future]:
         """Move, settle and capture stop ``k``: its index, stop, status, laps and pair to come
         (:class:`cell.run.ahead.PairsAhead`)."""
         stop = self.tour.stops[k]
-        clock = _Laps()
+        clock = Laps()
         self._move(k, f"stop {k} ({stop.hole_id})")
         clock.lap("move_s")
         st = self._settled_status()
@@ -336,7 +331,7 @@ class Runner(ReferencePhase):
         clock.lap("capture_s")
         return k, stop, st, clock, pair
 
-    def _finish_stop(self, captured: tuple[int, Any, m.Status, _Laps, Future],
+    def _finish_stop(self, captured: tuple[int, Any, m.Status, Laps, Future],
                      result: RunResult) -> None:  # fmt: skip
         """Measure, compensate, compare, store, record a captured stop; add it to ``result``
         with the wall time (s) of each step."""
@@ -353,7 +348,7 @@ class Runner(ReferencePhase):
         result.stored.append(hole)
         result.hole_timings.append(laps)
 
-    def _process_pair(self, k: int, stop, pair, st, clock: _Laps, kept: bool
+    def _process_pair(self, k: int, stop, pair, st, clock: Laps, kept: bool
                       ) -> tuple[HoleResult, dict[str, float]]:  # fmt: skip
         """Locate, measure, compensate, compare, store and record stop ``k``'s pair."""
         T_arm = (T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
@@ -394,7 +389,7 @@ class Runner(ReferencePhase):
         clock.laps["measure_s"] = result.measure_time_s
         return result, clock.laps
 
-    def _uncaptured(self, k: int, hole_id: str, exc: PairError, st, clock: _Laps
+    def _uncaptured(self, k: int, hole_id: str, exc: PairError, st, clock: Laps
                     ) -> tuple[HoleResult, dict[str, float]]:  # fmt: skip
         """Store stop ``k`` as unmeasured with the camera's reason (a resume retries it)."""
         clock.lap("render_s")
@@ -404,17 +399,3 @@ class Runner(ReferencePhase):
         self.store.record_hole(result)
         self.progress("hole", {"stop": k, "result": result})
         return result, clock.laps
-
-
-class _Laps:
-    def __init__(self) -> None:
-        self.laps: dict[str, float] = {}
-        self._t = time.perf_counter()
-
-    def lap(self, name: str) -> None:
-        t = time.perf_counter()
-        self.laps[name], self._t = t - self._t, t
-
-    def skip(self) -> None:
-        """Start the next lap now: the time since the last one is nobody's."""
-        self._t = time.perf_counter()
