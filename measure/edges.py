@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 
 from measure.detect import HoleCandidate
+from measure.edge_kernels import parabola_points
 from measure.masks import above, below, grow_box, ring_mask
 from measure.outline import without_bites
 from measure.slope import slope_shift
@@ -298,25 +299,13 @@ def subpixel_edges(
     xs, ys = found[:, 0], found[:, 1]
     keep = (xs >= 3) & (ys >= 3) & (xs < w - 3) & (ys < h - 3)
     xs, ys = xs[keep], ys[keep]
-    gxs, gys = gx[ys, xs], gy[ys, xs]
-    horiz = np.abs(gxs) >= np.abs(gys)
-    sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
-    # the gradient magnitude at each pixel and its two neighbours along the dominant axis
-    g0 = mag[ys, xs].astype(np.float64)
-    gm = mag[ys - sy, xs - sx].astype(np.float64)
-    gp = mag[ys + sy, xs + sx].astype(np.float64)
     if method == "parabola":
-        off, ok = _parabola(gm, g0, gp)
+        pts, strength, gxs, gys, widths, normals = parabola_points(xs, ys, gx, gy, mag)
     else:
-        raw = sub.astype(np.float32) * np.float32(1.0 / full)
-        off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
-    pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
-    gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
-    widths = _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
+        pts, strength, gxs, gys, widths = _linear_points(sub, full, gx, gy, mag, xs, ys)
     finite = widths[np.isfinite(widths)]
     blur = _percentile(finite, 50.0) if len(finite) else 0.0
     if slope_correction and method == "parabola" and len(pts):
-        normals = np.stack([gxs, gys], axis=1) / np.maximum(strength, 1e-12)[:, None]
         centre = (region.centroid_px[0] - x0, region.centroid_px[1] - y0)
         shift = slope_shift(gx, gy, pts, normals, strength, blur, centre)
         pts -= shift[:, None] * normals
@@ -326,6 +315,23 @@ def subpixel_edges(
         blur_sigma_px=blur,
         width_px=widths,
     )
+
+
+def _linear_points(sub, full, gx, gy, mag, xs, ys):
+    """The linear method's points (M, 2), and per point the magnitude, the gradient and
+    the edge width (as :func:`measure.edge_kernels.parabola_points` gives them)."""
+    gxs, gys = gx[ys, xs], gy[ys, xs]
+    horiz = np.abs(gxs) >= np.abs(gys)
+    sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
+    # the gradient magnitude at each pixel and its two neighbours along the dominant axis
+    g0 = mag[ys, xs].astype(np.float64)
+    gm = mag[ys - sy, xs - sx].astype(np.float64)
+    gp = mag[ys + sy, xs + sx].astype(np.float64)
+    raw = sub.astype(np.float32) * np.float32(1.0 / full)
+    off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
+    pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
+    gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
+    return pts, strength, gxs, gys, _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
 
 
 def _edge_widths(gm, g0, gp, gxs, gys, horiz) -> np.ndarray:
@@ -338,17 +344,6 @@ def _edge_widths(gm, g0, gp, gxs, gys, horiz) -> np.ndarray:
     along = np.where(horiz, np.abs(gxs), np.abs(gys)) / g
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(curv < 0, np.sqrt(-1.0 / curv) * along, np.inf)
-
-
-def _parabola(gm, g0, gp) -> tuple[np.ndarray, np.ndarray]:
-    """Vertex offset (px, along the dominant axis) of the parabola through the magnitudes
-    before, at and after each pixel, and where it is a maximum within half a pixel."""
-    den = gm - 2.0 * g0 + gp
-    ok = (den < 0) & (g0 >= gm) & (g0 >= gp)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        off = np.where(ok, 0.5 * (gm - gp) / den, 0.0)
-    ok &= np.abs(off) <= 0.5
-    return off, ok
 
 
 def _linear(raw, gx, gy, xs, ys, sx, sy) -> tuple[np.ndarray, np.ndarray]:

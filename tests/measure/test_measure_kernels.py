@@ -1,0 +1,80 @@
+"""The compiled loops of the measurement against the NumPy expressions they replace."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from measure.circle_kernels import rim_view_angles_max, solve_small
+from measure.edge_kernels import parabola_points
+from measure.edges import _edge_widths, gradient_kernels
+from measure.nearside import rim_view_angles
+
+
+def _reference_parabola(xs, ys, gx, gy, mag):
+    """The array expressions of ``subpixel_edges`` before the compiled loop."""
+    gxs, gys = gx[ys, xs], gy[ys, xs]
+    horiz = np.abs(gxs) >= np.abs(gys)
+    sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
+    g0 = mag[ys, xs].astype(np.float64)
+    gm = mag[ys - sy, xs - sx].astype(np.float64)
+    gp = mag[ys + sy, xs + sx].astype(np.float64)
+    den = gm - 2.0 * g0 + gp
+    ok = (den < 0) & (g0 >= gm) & (g0 >= gp)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        off = np.where(ok, 0.5 * (gm - gp) / den, 0.0)
+    ok &= np.abs(off) <= 0.5
+    pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
+    gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
+    widths = _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
+    normals = np.stack([gxs, gys], axis=1) / np.maximum(strength, 1e-12)[:, None]
+    return pts, strength, gxs, gys, widths, normals
+
+
+def test_parabola_points_match_the_array_expressions():
+    rng = np.random.default_rng(3)
+    img = np.full((120, 140), 200, np.uint8)
+    cv2.ellipse(img, ((70.3, 58.6), (80.0, 61.0), 17.0), 40, thickness=-1)
+    img = cv2.GaussianBlur(img, (0, 0), 1.2)
+    img = np.clip(img + rng.normal(0, 2.0, img.shape), 0, 255).astype(np.uint8)
+    kd, ks = gradient_kernels(1.0, 255.0)
+    gx = cv2.sepFilter2D(img, cv2.CV_32F, kd, ks)
+    gy = cv2.sepFilter2D(img, cv2.CV_32F, ks, kd)
+    mag = cv2.magnitude(gx, gy)
+    ys, xs = np.nonzero(mag[1:-1, 1:-1] > 0.2 * mag.max())
+    xs, ys = (xs + 1).astype(np.intp), (ys + 1).astype(np.intp)
+    got = parabola_points(xs, ys, gx, gy, mag)
+    want = _reference_parabola(xs, ys, gx, gy, mag)
+    assert 100 < len(got[0]) < len(xs)  # some pixels are maxima, not all
+    for g, w in zip(got, want, strict=True):
+        assert g.shape == w.shape
+        if g.dtype == np.float32:
+            assert np.array_equal(g, w)
+        else:
+            np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-12)
+
+
+def test_rim_view_angles_max_matches_the_array_expressions():
+    rng = np.random.default_rng(5)
+    center, normal = np.array([0.01, -0.02, 0.25]), np.array([0.2, 0.1, -1.0])
+    normal /= np.linalg.norm(normal)
+    pts = center + rng.normal(0.0, 0.005, (300, 3))
+    cams = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.05, 0.08, 0.02]])
+    want = rim_view_angles(pts, center, normal, cams).max(axis=1)
+    np.testing.assert_allclose(rim_view_angles_max(pts, center, normal, cams), want, atol=1e-13)
+
+
+def test_small_solve_matches_lapack_and_reports_a_singular_matrix():
+    rng = np.random.default_rng(9)
+    for _ in range(20):
+        a = rng.normal(size=(6, 6))
+        M = a @ a.T + 0.1 * np.eye(6)  # as JᵀJ + λ D: symmetric positive definite
+        b = rng.normal(size=6)
+        x, ok = solve_small(M, b)
+        assert ok
+        np.testing.assert_allclose(x, np.linalg.solve(M, b), rtol=1e-9, atol=1e-12)
+    x, ok = solve_small(np.zeros((6, 6)), np.ones(6))
+    assert not ok
+    with pytest.raises(np.linalg.LinAlgError):
+        np.linalg.solve(np.zeros((6, 6)), np.ones(6))
