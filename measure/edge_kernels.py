@@ -61,3 +61,68 @@ def parabola_points(xs, ys, gx, gy, mag):
         normal[m, 1] = b / s
         m += 1
     return pts[:m], strength[:m], gxo[:m], gyo[:m], width[:m], normal[:m]
+
+
+@njit(cache=True)
+def slope_queries(pts, normals, center, offset_px):
+    """Where :func:`measure.slope.slope_shift` reads the inside slope: per point, whether
+    its normal points into the hole (toward ``center``), the point moved ``offset_px``
+    along the normal to the inside (x and y as float32 (N, 1) maps for ``cv2.remap``),
+    and the point's angle about ``center`` (rad)."""
+    n = pts.shape[0]
+    inward = np.empty(n, np.bool_)
+    qx = np.empty((n, 1), np.float32)
+    qy = np.empty((n, 1), np.float32)
+    ang = np.empty(n)
+    for i in range(n):
+        dx, dy = pts[i, 0] - center[0], pts[i, 1] - center[1]
+        inward[i] = -dx * normals[i, 0] - dy * normals[i, 1] > 0
+        f = (1.0 if inward[i] else -1.0) * offset_px
+        qx[i, 0] = pts[i, 0] + f * normals[i, 0]
+        qy[i, 0] = pts[i, 1] + f * normals[i, 1]
+        ang[i] = np.arctan2(dy, dx)
+    return inward, qx, qy, ang
+
+
+@njit(cache=True)
+def slope_offsets(sx, sy, normals, peak, inward, tail, sigma_px):
+    """x* per point (:mod:`measure.slope`) from the gradient samples ``sx, sy`` (float32)
+    read inside: the inside slope along the normal less the step's own Gaussian tail
+    (``tail`` × peak), over √(2π) σ × peak, signed by the side; 0 where not finite."""
+    n = peak.shape[0]
+    out = np.empty(n)
+    k = np.sqrt(2.0 * np.pi)
+    for i in range(n):
+        s = np.float64(sx[i]) * normals[i, 0] + np.float64(sy[i]) * normals[i, 1]
+        s -= peak[i] * tail
+        num = s if inward[i] else 0.0 - s
+        x = num * sigma_px / (k * peak[i]) if peak[i] != 0.0 else np.inf
+        out[i] = x if np.isfinite(x) else 0.0
+    return out
+
+
+@njit(cache=True)
+def curvature_polar(pts, cx, cy, a, b, c, s, sigma_px, ox, oy):
+    """:func:`measure.contour.curvature_correction` of the points (N, 2) for the ellipse
+    centred at (cx, cy) with half axes a, b along (c, s) and blur ``sigma_px``, then the
+    corrected points' angle and distance about (ox, oy): one pass."""
+    n = pts.shape[0]
+    out = np.empty((n, 2))
+    theta = np.empty(n)
+    r = np.empty(n)
+    k = 0.5 * sigma_px**2
+    for i in range(n):
+        dx, dy = pts[i, 0] - cx, pts[i, 1] - cy
+        u = dx * c + dy * s
+        v = dy * c - dx * s
+        phi = np.arctan2(v / b, u / a)
+        cp, sp = np.cos(phi), np.sin(phi)
+        kappa = a * b / (a * a * sp**2 + b * b * cp**2) ** 1.5
+        nu, nv = cp / a, sp / b
+        shift = k * kappa / np.hypot(nu, nv)
+        x = pts[i, 0] + shift * (nu * c - nv * s)
+        y = pts[i, 1] + shift * (nu * s + nv * c)
+        out[i, 0], out[i, 1] = x, y
+        theta[i] = np.arctan2(y - oy, x - ox)
+        r[i] = np.hypot(x - ox, y - oy)
+    return out, theta, r

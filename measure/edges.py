@@ -48,6 +48,7 @@ class HoleRegion:
     inside_level: float = 0.0
     outside_level: float = 0.0
     ring_level: float = 0.0
+    box: tuple[int, int, int, int] | None = None  # the mask's bounding box, ROI pixels
 
 
 @dataclass(frozen=True)
@@ -108,6 +109,14 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> tuple[np.ndarray, Bo
     return region, box
 
 
+def _count(mask: np.ndarray, box: tuple[int, int, int, int] | None) -> float:
+    """Set pixels of ``mask``, all of which lie in ``box`` (x, y, w, h)."""
+    if box is None:
+        return 0.0
+    x, y, w, h = box
+    return float(cv2.countNonZero(mask[y : y + h, x : x + w]))
+
+
 def hole_region(
     img: np.ndarray, full: float, cand: HoleCandidate, margin_px: int = 10
 ) -> HoleRegion:
@@ -146,15 +155,14 @@ def hole_region(
     if rbox is not None:
         k = max(4, int(0.03 * cand.diameter_px))
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
-        ys, xs, _, _ = grow_box(rbox, 3, region.shape)  # the kernel's reach: zeros round the box
-        core = np.zeros(region.shape, np.uint8)
-        core[ys, xs] = cv2.erode(region[ys, xs], ker)
+        cys, cxs, _, _ = grow_box(rbox, 3, region.shape)  # the kernel's reach: zeros round it
+        core = cv2.erode(region[cys, cxs], ker)  # (zero outside that box)
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
         ys, xs, _, _ = grow_box(rbox, 5 + 2 * k, region.shape)  # holds the ring 3 … 3 + k px
         lout = _median(roi_img[ys, xs], ring_mask(dist[ys, xs], 3, 3 + k), full)
         if not dark and lout is not None:  # the lit part only, not the wall crescent
-            core &= above(roi_img, lout * full)
-        lin = _median(roi_img, core, full)
+            core &= above(roi_img[cys, cxs], lout * full)
+        lin = _median(roi_img[cys, cxs], core, full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
@@ -163,17 +171,18 @@ def hole_region(
             else:  # a lit background: the bore wall seen at a tilt is a dark crescent
                 mask = above(roi_img, level * full) | (roi_img < (2 * lout - level) * full)
             refined, fbox = _region(mask, seed)
-            ratio = float(cv2.countNonZero(refined)) / float(cv2.countNonZero(region))
+            ratio = _count(refined, fbox) / _count(region, rbox)
             # the same region, better placed; else keep the first (moved by a pixel or two:
             # the first distance map serves)
             if 0.6 < ratio < 1.6:
                 region, rbox = refined, fbox
+    mask = region.view(bool)  # 0/1
     if rbox is None:
-        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
+        return HoleRegion(box, (cx, cy), 0.0, mask, level, inside, outside, outside)
     bx, by = rbox[:2]
     mom = cv2.moments(region[by : by + rbox[3], bx : bx + rbox[2]], binaryImage=True)
     if mom["m00"] <= 0:
-        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
+        return HoleRegion(box, (cx, cy), 0.0, mask, level, inside, outside, outside, rbox)
     centroid = (mom["m10"] / mom["m00"] + bx + x0, mom["m01"] / mom["m00"] + by + y0)
     d = 2.0 * np.sqrt(mom["m00"] / np.pi)
     if dist is None:
@@ -183,11 +192,12 @@ def hole_region(
         box,
         centroid,
         float(mom["m00"]),
-        region > 0,
+        mask,
         level,
         inside,
         outside,
         outside if wide is None else wide,
+        rbox,
     )
 
 
@@ -244,11 +254,12 @@ def gradient_kernels(sigma_px: float, full: float) -> tuple[np.ndarray, np.ndarr
 _CROP_MARGIN_PX = 7
 
 
-def _edge_crop(mask: np.ndarray, band_px: int) -> tuple[int, int, int, int]:
-    """(x0, y0, x1, y1) of the ROI part the edge step needs: the outline band and its reach."""
-    bx, by, bw, bh = cv2.boundingRect(mask.view(np.uint8))
+def _edge_crop(box, shape, band_px: int) -> tuple[int, int, int, int]:
+    """(x0, y0, x1, y1) of the ROI part the edge step needs: the outline band and its
+    reach, from the region's box (x, y, w, h) in the ROI of ``shape`` (h, w)."""
+    bx, by, bw, bh = box
     m = band_px + _CROP_MARGIN_PX
-    H, W = mask.shape
+    H, W = shape
     return max(bx - m, 0), max(by - m, 0), min(bx + bw + m, W), min(by + bh + m, H)
 
 
@@ -270,10 +281,10 @@ def subpixel_edges(
     """
     if method not in EDGE_METHODS:
         raise ValueError(f"edge method must be one of {EDGE_METHODS}, got {method!r}")
-    if not region.mask.any():
+    if region.box is None:
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
     rx, ry = region.roi[:2]
-    cx0, cy0, cx1, cy1 = _edge_crop(region.mask, 3)
+    cx0, cy0, cx1, cy1 = _edge_crop(region.box, region.mask.shape, 3)
     x0, y0, w, h = rx + cx0, ry + cy0, cx1 - cx0, cy1 - cy0
     sub = img[y0 : y0 + h, x0 : x0 + w]
     kd, ks = gradient_kernels(float(sigma_px), float(full))
@@ -300,9 +311,9 @@ def subpixel_edges(
     keep = (xs >= 3) & (ys >= 3) & (xs < w - 3) & (ys < h - 3)
     xs, ys = xs[keep], ys[keep]
     if method == "parabola":
-        pts, strength, gxs, gys, widths, normals = parabola_points(xs, ys, gx, gy, mag)
+        pts, strength, _, _, widths, normals = parabola_points(xs, ys, gx, gy, mag)
     else:
-        pts, strength, gxs, gys, widths = _linear_points(sub, full, gx, gy, mag, xs, ys)
+        pts, strength, widths = _linear_points(sub, full, gx, gy, mag, xs, ys)
     finite = widths[np.isfinite(widths)]
     blur = _percentile(finite, 50.0) if len(finite) else 0.0
     if slope_correction and method == "parabola" and len(pts):
@@ -318,8 +329,8 @@ def subpixel_edges(
 
 
 def _linear_points(sub, full, gx, gy, mag, xs, ys):
-    """The linear method's points (M, 2), and per point the magnitude, the gradient and
-    the edge width (as :func:`measure.edge_kernels.parabola_points` gives them)."""
+    """The linear method's points (M, 2), and per point the gradient magnitude and the
+    edge width (as :func:`measure.edge_kernels.parabola_points` gives them)."""
     gxs, gys = gx[ys, xs], gy[ys, xs]
     horiz = np.abs(gxs) >= np.abs(gys)
     sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
@@ -331,7 +342,7 @@ def _linear_points(sub, full, gx, gy, mag, xs, ys):
     off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
     pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
     gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
-    return pts, strength, gxs, gys, _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
+    return pts, strength, _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
 
 
 def _edge_widths(gm, g0, gp, gxs, gys, horiz) -> np.ndarray:

@@ -78,3 +78,60 @@ def test_small_solve_matches_lapack_and_reports_a_singular_matrix():
     assert not ok
     with pytest.raises(np.linalg.LinAlgError):
         np.linalg.solve(np.zeros((6, 6)), np.ones(6))
+
+
+def test_curvature_polar_matches_the_correction_and_the_polar_form():
+    from measure.contour import curvature_correction
+    from measure.edge_kernels import curvature_polar
+
+    rng = np.random.default_rng(4)
+    ell = ((310.2, 205.7), (180.0, 150.0), 23.0)
+    t = np.deg2rad(ell[2])
+    phi = rng.uniform(-np.pi, np.pi, 400)
+    u, v = 90.0 * np.cos(phi), 75.0 * np.sin(phi)
+    pts = np.stack(
+        [310.2 + u * np.cos(t) - v * np.sin(t), 205.7 + u * np.sin(t) + v * np.cos(t)], 1
+    )
+    pts += rng.normal(0.0, 0.3, pts.shape)
+    want = curvature_correction(pts, ell, 1.7)
+    got, theta, r = curvature_polar(
+        pts, 310.2, 205.7, 90.0, 75.0, np.cos(t), np.sin(t), 1.7, 311.0, 204.0
+    )
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-11)
+    d = want - (311.0, 204.0)
+    np.testing.assert_allclose(theta, np.arctan2(d[:, 1], d[:, 0]), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(r, np.hypot(d[:, 0], d[:, 1]), rtol=1e-14)
+
+
+def test_slope_kernels_match_the_array_expressions():
+    from measure.edge_kernels import slope_offsets, slope_queries
+
+    rng = np.random.default_rng(6)
+    phi = rng.uniform(-np.pi, np.pi, 300)
+    centre = np.array([50.0, 40.0])
+    pts = centre + 30.0 * np.stack([np.cos(phi), np.sin(phi)], 1)
+    nrm = (
+        np.stack([np.cos(phi), np.sin(phi)], 1)
+        * np.where(rng.random(300) < 0.7, 1.0, -1.0)[:, None]
+    )
+    inward, qx, qy, ang = slope_queries(pts, nrm, centre, 4.5)
+    want_in = np.einsum("ij,ij->i", centre - pts, nrm) > 0
+    side = np.where(want_in, 1.0, -1.0)
+    q = pts + (side * 4.5)[:, None] * nrm
+    assert np.array_equal(inward, want_in)
+    assert np.array_equal(qx.ravel(), q[:, 0].astype(np.float32))
+    assert np.array_equal(qy.ravel(), q[:, 1].astype(np.float32))
+    np.testing.assert_allclose(ang, np.arctan2(pts[:, 1] - 40.0, pts[:, 0] - 50.0), atol=1e-12)
+    sx, sy = rng.normal(0, 1, 300).astype(np.float32), rng.normal(0, 1, 300).astype(np.float32)
+    peak = rng.uniform(0.5, 2.0, 300)
+    peak[0] = 0.0  # not finite: 0
+    s = sx * nrm[:, 0] + sy * nrm[:, 1] - peak * 0.0111
+    with np.errstate(divide="ignore", invalid="ignore"):
+        want = (
+            (np.where(want_in, s, 0.0) - np.where(want_in, 0.0, s))
+            * 1.3
+            / (np.sqrt(2 * np.pi) * peak)
+        )
+    want = np.where(np.isfinite(want), want, 0.0)
+    got = slope_offsets(sx, sy, nrm, peak, inward, 0.0111, 1.3)
+    np.testing.assert_allclose(got, want, rtol=1e-14, atol=1e-15)
