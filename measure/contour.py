@@ -15,9 +15,8 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy.ndimage import median_filter
 
-from measure.edge_kernels import curvature_polar
+from measure.edge_kernels import curvature_polar, periodic_median
 
 #: ``cv2.fitEllipse`` style: ((cx, cy), (full axis 1, full axis 2), angle in degrees)
 Ellipse = tuple[tuple[float, float], tuple[float, float], float]
@@ -146,7 +145,7 @@ def _polar_clean(r: np.ndarray, window: int = 9) -> np.ndarray:
     n = len(r)
     if n < window:
         return np.ones(n, dtype=bool)
-    med = median_filter(r, size=window, mode="wrap")
+    med = periodic_median(np.ascontiguousarray(r, np.float64), window)
     return np.abs(r - med) < 1.0
 
 

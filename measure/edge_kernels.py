@@ -126,3 +126,27 @@ def curvature_polar(pts, cx, cy, a, b, c, s, sigma_px, ox, oy):
         theta[i] = np.arctan2(y - oy, x - ox)
         r[i] = np.hypot(x - ox, y - oy)
     return out, theta, r
+
+
+@njit(cache=True)
+def periodic_median(values, window):
+    """Running median over ``window`` (odd) neighbours of a periodic sequence (n ≥ window):
+    ``scipy.ndimage.median_filter(values, size=window, mode="wrap")``, the middle value of
+    each window being picked as that does (an element, so the same to the bit), without
+    its per-call set-up (which was most of its time on a few hundred values)."""
+    n = values.shape[0]
+    h = window // 2
+    out = np.empty(n)
+    buf = np.empty(window)
+    for i in range(n):
+        for k in range(window):
+            buf[k] = values[(i - h + k) % n]
+        for k in range(1, window):  # insertion sort: a dozen values
+            v = buf[k]
+            m = k - 1
+            while m >= 0 and buf[m] > v:
+                buf[m + 1] = buf[m]
+                m -= 1
+            buf[m + 1] = v
+        out[i] = buf[h]
+    return out

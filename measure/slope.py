@@ -41,9 +41,8 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from scipy.ndimage import median_filter
 
-from measure.edge_kernels import slope_offsets, slope_queries
+from measure.edge_kernels import periodic_median, slope_offsets, slope_queries
 
 #: the inside slope is read this many blur σ from the edge point
 SLOPE_OFFSET_SIGMA = 3.0
@@ -60,7 +59,7 @@ def _running_median(values: np.ndarray, angles: np.ndarray, window: int) -> np.n
         return values
     order = np.argsort(angles)
     out = np.empty(n)
-    out[order] = median_filter(values[order], size=window, mode="wrap")
+    out[order] = periodic_median(np.ascontiguousarray(values[order], np.float64), window)
     return out
 
 

@@ -135,3 +135,17 @@ def test_slope_kernels_match_the_array_expressions():
     want = np.where(np.isfinite(want), want, 0.0)
     got = slope_offsets(sx, sy, nrm, peak, inward, 0.0111, 1.3)
     np.testing.assert_allclose(got, want, rtol=1e-14, atol=1e-15)
+
+
+@pytest.mark.parametrize("window", [9, 15])
+def test_periodic_median_is_scipys_wrapped_median_filter(window):
+    from scipy.ndimage import median_filter
+
+    from measure.edge_kernels import periodic_median
+
+    rng = np.random.default_rng(window)
+    for n in (window, window + 1, 613):
+        v = np.round(rng.normal(0.0, 1.0, n), 1)  # with ties
+        assert np.array_equal(
+            periodic_median(v, window), median_filter(v, size=window, mode="wrap")
+        )
