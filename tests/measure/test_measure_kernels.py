@@ -149,3 +149,14 @@ def test_periodic_median_is_scipys_wrapped_median_filter(window):
         assert np.array_equal(
             periodic_median(v, window), median_filter(v, size=window, mode="wrap")
         )
+
+
+def test_histogram_is_opencvs():
+    from measure.image_kernels import histogram_u8
+
+    rng = np.random.default_rng(8)
+    for shape in ((512, 612), (7, 5), (1, 3)):
+        img = rng.integers(0, 256, shape, dtype=np.uint8)
+        img[0, 0] = 255
+        want = cv2.calcHist([img], [0], None, [256], [0, 256]).ravel()
+        assert np.array_equal(histogram_u8(img), want)
