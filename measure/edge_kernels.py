@@ -150,3 +150,39 @@ def periodic_median(values, window):
             buf[m + 1] = v
         out[i] = buf[h]
     return out
+
+
+@njit(cache=True)
+def scaled_int16(gx, gy, scale):
+    """``(gx * scale).astype(np.int16)`` and the same of ``gy`` (float32 images and scale:
+    the product rounded to float32, then truncated toward zero), Canny's input, in one
+    pass without the float32 temporaries."""
+    h, w = gx.shape
+    dx = np.empty((h, w), np.int16)
+    dy = np.empty((h, w), np.int16)
+    for i in range(h):
+        for j in range(w):
+            dx[i, j] = np.int16(gx[i, j] * scale)
+            dy[i, j] = np.int16(gy[i, j] * scale)
+    return dx, dy
+
+
+@njit(cache=True)
+def binary_moments(mask):
+    """m00, m10, m01 of a 0/nonzero ``uint8`` image (pixel counts and coordinate sums, as
+    ``cv2.moments(mask, binaryImage=True)``; integers, so the same to the bit)."""
+    m00 = 0
+    m10 = 0
+    m01 = 0
+    h, w = mask.shape
+    for i in range(h):
+        n = 0
+        sx = 0
+        for j in range(w):
+            if mask[i, j]:
+                n += 1
+                sx += j
+        m00 += n
+        m10 += sx
+        m01 += n * i
+    return float(m00), float(m10), float(m01)

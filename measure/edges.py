@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 
 from measure.detect import HoleCandidate
-from measure.edge_kernels import parabola_points
+from measure.edge_kernels import binary_moments, parabola_points, scaled_int16
 from measure.masks import above, below, grow_box, ring_mask
 from measure.outline import without_bites
 from measure.slope import slope_shift
@@ -180,18 +180,18 @@ def hole_region(
     if rbox is None:
         return HoleRegion(box, (cx, cy), 0.0, mask, level, inside, outside, outside)
     bx, by = rbox[:2]
-    mom = cv2.moments(region[by : by + rbox[3], bx : bx + rbox[2]], binaryImage=True)
-    if mom["m00"] <= 0:
+    m00, m10, m01 = binary_moments(region[by : by + rbox[3], bx : bx + rbox[2]])
+    if m00 <= 0:
         return HoleRegion(box, (cx, cy), 0.0, mask, level, inside, outside, outside, rbox)
-    centroid = (mom["m10"] / mom["m00"] + bx + x0, mom["m01"] / mom["m00"] + by + y0)
-    d = 2.0 * np.sqrt(mom["m00"] / np.pi)
+    centroid = (m10 / m00 + bx + x0, m01 / m00 + by + y0)
+    d = 2.0 * np.sqrt(m00 / np.pi)
     if dist is None:
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
     wide = _median(roi_img, ring_mask(dist, 0.05 * d, 0.2 * d), full)
     return HoleRegion(
         box,
         centroid,
-        float(mom["m00"]),
+        m00,
         mask,
         level,
         inside,
@@ -299,8 +299,7 @@ def subpixel_edges(
     if peak <= 0:
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
     scale = np.float32(16000.0 / max(float(mag.max()), 1e-12))  # |g| ≤ max: no clipping
-    dx = (gx * scale).astype(np.int16)
-    dy = (gy * scale).astype(np.int16)
+    dx, dy = scaled_int16(gx, gy, scale)
     hi = 0.35 * peak * float(scale)
     edges = cv2.Canny(dx, dy, 0.5 * hi, hi, L2gradient=True)
     found = cv2.findNonZero(cv2.bitwise_and(edges, band))  # row by row, as np.nonzero

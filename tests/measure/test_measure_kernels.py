@@ -160,3 +160,20 @@ def test_histogram_is_opencvs():
         img[0, 0] = 255
         want = cv2.calcHist([img], [0], None, [256], [0, 256]).ravel()
         assert np.array_equal(histogram_u8(img), want)
+
+
+def test_scaled_int16_and_binary_moments_match_numpy_and_opencv():
+    from measure.edge_kernels import binary_moments, scaled_int16
+
+    rng = np.random.default_rng(12)
+    gx = rng.normal(0.0, 1.0, (60, 70)).astype(np.float32)
+    gy = rng.normal(0.0, 1.0, (60, 70)).astype(np.float32)
+    scale = np.float32(16000.0 / np.abs(gx).max())
+    dx, dy = scaled_int16(gx, gy, scale)
+    assert np.array_equal(dx, (gx * scale).astype(np.int16))
+    assert np.array_equal(dy, (gy * scale).astype(np.int16))
+    mask = np.zeros((90, 120), np.uint8)
+    cv2.ellipse(mask, ((60.4, 41.2), (70.0, 50.0), 33.0), 1, thickness=-1)
+    window = mask[5:85, 7:113]  # a view, as the region's box
+    m = cv2.moments(window, binaryImage=True)
+    assert binary_moments(window) == (m["m00"], m["m10"], m["m01"])
