@@ -22,8 +22,13 @@ import cv2
 import numpy as np
 
 from measure.detect import HoleCandidate
-from measure.edge_kernels import binary_moments, parabola_points, scaled_int16
-from measure.masks import above, below, grow_box, ring_mask
+from measure.edge_kernels import (
+    binary_moments,
+    parabola_points,
+    ring_histogram,
+    scaled_int16,
+)
+from measure.masks import above, below, grow_box, ring_bounds, ring_mask
 from measure.outline import without_bites
 from measure.slope import slope_shift
 
@@ -71,6 +76,21 @@ def _median(img: np.ndarray, mask: np.ndarray, full: float) -> float | None:
     or bool mask), from a histogram; ``None`` when no pixel is masked."""
     bins = 256 if img.dtype == np.uint8 else 1024
     hist = cv2.calcHist([img], [0], mask.view(np.uint8), [bins], [0, full + 1]).ravel()
+    return _hist_median(hist, bins, full)
+
+
+def _ring_median(img: np.ndarray, dist: np.ndarray, inner: float, outer: float, full: float):
+    """:func:`_median` of the pixels ``inner`` (exclusive) … ``outer`` px outside the
+    region (:func:`measure.masks.ring_mask` of its distance map ``dist``); for 8-bit
+    images one compiled pass (:func:`measure.edge_kernels.ring_histogram`)."""
+    if img.dtype != np.uint8:
+        return _median(img, ring_mask(dist, inner, outer), full)
+    lo, hi = ring_bounds(inner, outer)
+    return _hist_median(ring_histogram(img, dist, lo, hi).astype(np.float32), 256, full)
+
+
+def _hist_median(hist: np.ndarray, bins: int, full: float) -> float | None:
+    """The median's gray level (fraction of full scale) from float32 histogram counts."""
     cdf = np.cumsum(hist)
     if cdf[-1] <= 0:
         return None
@@ -159,7 +179,7 @@ def hole_region(
         core = cv2.erode(region[cys, cxs], ker)  # (zero outside that box)
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
         ys, xs, _, _ = grow_box(rbox, 5 + 2 * k, region.shape)  # holds the ring 3 … 3 + k px
-        lout = _median(roi_img[ys, xs], ring_mask(dist[ys, xs], 3, 3 + k), full)
+        lout = _ring_median(roi_img[ys, xs], dist[ys, xs], 3, 3 + k, full)
         if not dark and lout is not None:  # the lit part only, not the wall crescent
             core &= above(roi_img[cys, cxs], lout * full)
         lin = _median(roi_img[cys, cxs], core, full)
@@ -187,7 +207,7 @@ def hole_region(
     d = 2.0 * np.sqrt(m00 / np.pi)
     if dist is None:
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
-    wide = _median(roi_img, ring_mask(dist, 0.05 * d, 0.2 * d), full)
+    wide = _ring_median(roi_img, dist, 0.05 * d, 0.2 * d, full)
     return HoleRegion(
         box,
         centroid,

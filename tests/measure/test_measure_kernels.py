@@ -177,3 +177,17 @@ def test_scaled_int16_and_binary_moments_match_numpy_and_opencv():
     window = mask[5:85, 7:113]  # a view, as the region's box
     m = cv2.moments(window, binaryImage=True)
     assert binary_moments(window) == (m["m00"], m["m10"], m["m01"])
+
+
+def test_ring_histogram_is_calchist_under_the_ring_mask():
+    from measure.edge_kernels import ring_histogram
+    from measure.masks import ring_bounds, ring_mask
+
+    rng = np.random.default_rng(13)
+    region = np.zeros((150, 170), np.uint8)
+    cv2.circle(region, (80, 70), 40, 1, -1)
+    dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
+    img = rng.integers(0, 256, region.shape, dtype=np.uint8)
+    for inner, outer in ((3, 7), (0.05 * 80, 0.2 * 80), (2.865, 5.73)):  # bounds on the map's steps
+        want = cv2.calcHist([img], [0], ring_mask(dist, inner, outer), [256], [0, 256]).ravel()
+        assert np.array_equal(ring_histogram(img, dist, *ring_bounds(inner, outer)), want)
