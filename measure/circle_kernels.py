@@ -173,3 +173,31 @@ def lm_orthogonal(pts, sw, c, n, r, max_iter):
         else:
             lam *= 10.0
     return c, n, r, A, cost
+
+
+@njit(cache=True)
+def off_sectors(h, dr, sector, mask, min_points, limit):
+    """Points of ``mask`` in sectors (integer labels ``sector``) with at least
+    ``min_points`` of them whose median residual vector (median h, median ρ − r) is longer
+    than ``limit`` (:func:`measure.nearside._off_sectors`, one median pair per sector)."""
+    n = h.shape[0]
+    out = np.zeros(n, np.bool_)
+    lo, hi = 1 << 30, -(1 << 30)
+    for i in range(n):
+        if mask[i]:
+            lo, hi = min(lo, sector[i]), max(hi, sector[i])
+    hs = np.empty(n)
+    ds = np.empty(n)
+    for b in range(lo, hi + 1):
+        m = 0
+        for i in range(n):
+            if mask[i] and sector[i] == b:
+                hs[m], ds[m] = h[i], dr[i]
+                m += 1
+        if m < min_points:
+            continue
+        if np.hypot(np.median(hs[:m]), np.median(ds[:m])) > limit:
+            for i in range(n):
+                if mask[i] and sector[i] == b:
+                    out[i] = True
+    return out

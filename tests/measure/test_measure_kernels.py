@@ -191,3 +191,22 @@ def test_ring_histogram_is_calchist_under_the_ring_mask():
     for inner, outer in ((3, 7), (0.05 * 80, 0.2 * 80), (2.865, 5.73)):  # bounds on the map's steps
         want = cv2.calcHist([img], [0], ring_mask(dist, inner, outer), [256], [0, 256]).ravel()
         assert np.array_equal(ring_histogram(img, dist, *ring_bounds(inner, outer)), want)
+
+
+def test_off_sectors_matches_the_per_sector_medians():
+    from measure.circle_kernels import off_sectors
+
+    rng = np.random.default_rng(14)
+    n = 500
+    phi = rng.uniform(-np.pi, np.pi, n)
+    h, dr = rng.normal(0, 1.0, n), rng.normal(0, 1.0, n)
+    h[np.abs(phi) < 0.5] += 3.0  # some sectors off
+    mask = rng.random(n) < 0.6
+    k = np.floor((phi + np.pi) / np.deg2rad(10.0)).astype(np.int64)
+    want = np.zeros(n, bool)
+    for b in np.unique(k[mask]):
+        sel = mask & (k == b)
+        if sel.sum() >= 5 and np.hypot(np.median(h[sel]), np.median(dr[sel])) > 2.0:
+            want |= sel
+    got = off_sectors(h, dr, k, mask, 5, 2.0)
+    assert want.any() and np.array_equal(got, want)
