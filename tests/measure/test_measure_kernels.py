@@ -210,3 +210,47 @@ def test_off_sectors_matches_the_per_sector_medians():
             want |= sel
     got = off_sectors(h, dr, k, mask, 5, 2.0)
     assert want.any() and np.array_equal(got, want)
+
+
+def test_searchsorted_is_numpys_even_on_unsorted_arrays():
+    from measure.match_kernels import searchsorted_left
+
+    rng = np.random.default_rng(15)
+    for _ in range(50):
+        arr = np.sort(rng.normal(0.0, 1.0, 40))
+        arr[rng.integers(0, 40, 5)] = rng.normal(0.0, 1.0, 5)  # no longer sorted
+        keys = rng.normal(0.0, 1.2, 60)
+        keys[:20] = np.sort(keys[:20])
+        assert np.array_equal(searchsorted_left(arr, keys), np.searchsorted(arr, keys))
+
+
+def test_match_flank_is_the_array_expressions():
+    from measure.match import _flanks, _steep
+    from measure.match_kernels import match_flank
+
+    rng = np.random.default_rng(16)
+    t = np.linspace(-np.pi, np.pi, 400, endpoint=False)
+    src = np.stack([300 + 80 * np.cos(t), 200 + 60 * np.sin(t)], 1) + rng.normal(0, 0.3, (400, 2))
+    t2 = np.linspace(-np.pi, np.pi, 380, endpoint=False)
+    dst = np.stack([250 + 78 * np.cos(t2), 200.4 + 61 * np.sin(t2)], 1)
+    dst += rng.normal(0, 0.3, (380, 2))
+    ws, wd = rng.uniform(0, 1, 400), rng.uniform(0, 1, 380)
+    fs_, fd_ = rng.random(400) < 0.1, rng.random(380) < 0.1
+    ss, sd = _steep(src, 0.34), _steep(dst, 0.34)
+    for fs, fd in zip(_flanks(src), _flanks(dst), strict=True):
+        x, y, w, f, i, ok = match_flank(src, fs, dst, fd, ss, sd, ws, wd, fs_, fd_)
+        yd = dst[fd, 1]
+        fd = fd[np.concatenate([[True], np.diff(yd) > 0])]
+        yd, xd = dst[fd, 1], dst[fd, 0]
+        ys = src[fs, 1]
+        k = np.searchsorted(yd, ys)
+        inside = (k > 0) & (k < len(yd))
+        k = np.clip(k, 1, len(yd) - 1)
+        lo, hi = fd[k - 1], fd[k]
+        a = (ys - yd[k - 1]) / np.maximum(yd[k] - yd[k - 1], 1e-12)
+        keep = inside & ss[fs] & sd[lo] & sd[hi]
+        assert ok and keep.sum() > 100
+        assert np.array_equal(x, (xd[k - 1] + a * (xd[k] - xd[k - 1]))[keep])
+        assert np.array_equal(y, ys[keep]) and np.array_equal(i, fs[keep])
+        assert np.array_equal(w, (ws[fs] * np.minimum(wd[lo], wd[hi]))[keep])
+        assert np.array_equal(f, (fs_[fs] | fd_[lo] | fd_[hi])[keep])
