@@ -254,3 +254,28 @@ def test_match_flank_is_the_array_expressions():
         assert np.array_equal(y, ys[keep]) and np.array_equal(i, fs[keep])
         assert np.array_equal(w, (ws[fs] * np.minimum(wd[lo], wd[hi]))[keep])
         assert np.array_equal(f, (fs_[fs] | fd_[lo] | fd_[hi])[keep])
+
+
+def test_outline_prefilter_boxes_and_areas_are_opencvs():
+    from measure.outline import outline_prefilter
+
+    rng = np.random.default_rng(17)
+    mask = (cv2.GaussianBlur(rng.random((200, 240)), (0, 0), 3.0) > 0.52).astype(np.uint8)
+    cv2.circle(mask, (120, 100), 30, 1, -1)
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    lengths = np.array([len(c) for c in contours])
+    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+    pts = np.concatenate(contours).reshape(-1, 2)
+    for border_only in (False, True):
+        ok, boxes, _ = outline_prefilter(pts, starts, mask.shape, 12.0, border_only)
+        want = []
+        for c in contours:
+            x, y, w, h = cv2.boundingRect(c)
+            b = x == 0 or y == 0 or x + w == 240 or y + h == 200
+            a = cv2.contourArea(c)
+            compact = b or not (
+                a < 0.5 * w * h or min(w, h) < 0.3 * max(w, h) or 4 * np.pi * a < 0.45 * len(c) ** 2
+            )
+            want.append(w * h >= 12 and b == border_only and 12 <= a <= 0.5 * 200 * 240 and compact)
+            assert tuple(boxes[len(want) - 1]) == (x, y, w, h)
+        assert np.array_equal(ok, want) and 0 < ok.sum() < len(contours)
