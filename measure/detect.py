@@ -117,15 +117,14 @@ def _discs(
     contours, _ = cv2.findContours(
         mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE, offset=offset
     )
-    min_len = max(8, int(2.0 * np.sqrt(np.pi * min_area)))  # 2√(π A) ≈ the disc's perimeter
+    min_len = max(8, int(2.0 * math.sqrt(math.pi * min_area)))  # 2√(π A): a disc's perimeter
     out = []
-    lengths = np.fromiter(map(len, contours), dtype=np.intp, count=len(contours))
-    idx = np.flatnonzero(lengths >= min_len)
-    if len(idx) == 0:
+    sel = [c for c in contours if len(c) >= min_len]
+    if not sel:
         return out
-    sel = [contours[i] for i in idx]
-    starts = np.concatenate([[0], np.cumsum(lengths[idx])[:-1]])
-    pts = np.concatenate(sel).reshape(-1, 2)
+    lengths = np.fromiter(map(len, sel), dtype=np.intp, count=len(sel))
+    starts = np.cumsum(lengths) - lengths
+    pts = (np.concatenate(sel) if len(sel) > 1 else sel[0]).reshape(-1, 2)
     ok, boxes, borders = outline_prefilter(pts, starts, (H, W), float(min_area), border_only)
     for j in np.flatnonzero(ok):
         c = sel[j]
