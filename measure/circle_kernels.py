@@ -176,6 +176,22 @@ def lm_orthogonal(pts, sw, c, n, r, max_iter):
 
 
 @njit(cache=True)
+def _median(a):
+    """``np.median`` of a short 1-D array (sorted in place by insertion; the mean of the
+    two middle values when even, as NumPy): compiles in a fraction of numba's median."""
+    n = a.shape[0]
+    for k in range(1, n):
+        v = a[k]
+        m = k - 1
+        while m >= 0 and a[m] > v:
+            a[m + 1] = a[m]
+            m -= 1
+        a[m + 1] = v
+    h = n // 2
+    return a[h] if n % 2 else (a[h - 1] + a[h]) / 2.0
+
+
+@njit(cache=True)
 def off_sectors(h, dr, sector, mask, min_points, limit):
     """Points of ``mask`` in sectors (integer labels ``sector``) with at least
     ``min_points`` of them whose median residual vector (median h, median ρ − r) is longer
@@ -196,7 +212,7 @@ def off_sectors(h, dr, sector, mask, min_points, limit):
                 m += 1
         if m < min_points:
             continue
-        if np.hypot(np.median(hs[:m]), np.median(ds[:m])) > limit:
+        if np.hypot(_median(hs[:m]), _median(ds[:m])) > limit:
             for i in range(n):
                 if mask[i] and sector[i] == b:
                     out[i] = True

@@ -40,7 +40,7 @@ def _flanks(pts: np.ndarray) -> list[np.ndarray]:
     i_top, i_bot = int(np.argmin(pts[:, 1])), int(np.argmax(pts[:, 1]))
     a = (i_top + np.arange((i_bot - i_top) % n + 1)) % n
     b = (i_bot + np.arange((i_top - i_bot) % n + 1)) % n
-    b = b[::-1]  # also top → bottom
+    b = np.ascontiguousarray(b[::-1])  # also top → bottom (contiguous: one compiled variant)
     return [a, b] if pts[a, 0].mean() <= pts[b, 0].mean() else [b, a]
 
 
