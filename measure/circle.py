@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from measure.circle_kernels import orthogonal_distances, orthogonal_system
+from measure.circle_kernels import lm_orthogonal, orthogonal_distances
 from measure.errors import FitError
 
 CIRCLE_COSTS = ("orthogonal", "published")
@@ -144,17 +144,6 @@ def algebraic_circle(pts: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.nda
     return c0 + a * e0 + b * e1, n, float(np.sqrt(r2))
 
 
-def _orthogonal_system(pts, sw, c, n, r):
-    """Weighted residuals (h, ρ − r) of every point and their Jacobian with respect to
-    (c, a, b, r), the normal moved to n + a u + b v (u, v ⊥ n) and renormalised, at a = b = 0;
-    returned as JᵀJ (6 × 6), Jᵀe (6) and eᵀe (one compiled pass:
-    :func:`measure.circle_kernels.orthogonal_system`), with u and v."""
-    u, v = _basis(n)
-    c, n = np.ascontiguousarray(c, np.float64), np.ascontiguousarray(n, np.float64)
-    A, g, ee = orthogonal_system(pts, sw, c, n, u, v, float(r))
-    return A, g, float(ee), u, v
-
-
 def _lm_orthogonal(pts, sw, c, n, r, max_iter: int = 100):
     """Levenberg–Marquardt on the orthogonal cost (points in any length unit).
 
@@ -163,27 +152,16 @@ def _lm_orthogonal(pts, sw, c, n, r, max_iter: int = 100):
     algebraic circle it converges in two or three steps. Stops when the step would lower
     the cost by less than 1e-10 of itself (to first order) or is below 1e-10 of the radius.
     Returns centre, normal, radius, JᵀJ at the end, the cost eᵀe and the number of residuals.
+    The loop is compiled (:func:`measure.circle_kernels.lm_orthogonal`).
     """
-    A, g, cost, u, v = _orthogonal_system(pts, sw, c, n, r)
-    lam = 1e-6
-    for _ in range(max_iter):
-        D = np.diag(np.maximum(np.diag(A), 1e-300))
-        try:
-            step = np.linalg.solve(A + lam * D, -g)
-        except np.linalg.LinAlgError:
-            break
-        predicted = -(2.0 * step @ g + step @ A @ step)  # cost decrease of the linear model
-        if predicted <= 1e-10 * cost or np.abs(step).max() <= 1e-10 * abs(r):
-            break  # converged: what is left is rounding
-        nn = n + step[3] * u + step[4] * v
-        nn /= np.linalg.norm(nn)
-        cc, rr = c + step[:3], r + step[5]
-        A2, g2, cost2, u2, v2 = _orthogonal_system(pts, sw, cc, nn, rr)
-        if cost2 < cost:
-            c, n, r, A, g, cost, u, v = cc, nn, rr, A2, g2, cost2, u2, v2
-            lam = max(lam * 0.1, 1e-12)
-        else:
-            lam *= 10.0
+    c, n, r, A, cost = lm_orthogonal(
+        np.ascontiguousarray(pts, np.float64),
+        np.ascontiguousarray(sw, np.float64),
+        np.ascontiguousarray(c, np.float64),
+        np.ascontiguousarray(n, np.float64),
+        float(r),
+        max_iter,
+    )
     return c, n, r, A, cost, 2 * len(pts)
 
 

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy.ndimage import median_filter
+
+from measure.edge_kernels import curvature_polar, periodic_median
 
 #: ``cv2.fitEllipse`` style: ((cx, cy), (full axis 1, full axis 2), angle in degrees)
 Ellipse = tuple[tuple[float, float], tuple[float, float], float]
@@ -144,7 +145,7 @@ def _polar_clean(r: np.ndarray, window: int = 9) -> np.ndarray:
     n = len(r)
     if n < window:
         return np.ones(n, dtype=bool)
-    med = median_filter(r, size=window, mode="wrap")
+    med = periodic_median(np.ascontiguousarray(r, np.float64), window)
     return np.abs(r - med) < 1.0
 
 
@@ -194,10 +195,12 @@ def build_contour(
     if len(theta) < 12:
         return None
     ell, inl = robust_ellipse(pts)
-    if blur_sigma_px > 0:
-        pts = curvature_correction(pts, ell, blur_sigma_px)
-        d = pts - c
-        theta, r = np.arctan2(d[:, 1], d[:, 0]), np.hypot(d[:, 0], d[:, 1])
+    if blur_sigma_px > 0:  # curvature_correction, and the points' polar form again
+        (ex, ey), (a2, b2), ang = ell
+        t = math.radians(ang)
+        pts, theta, r = curvature_polar(np.ascontiguousarray(pts), ex, ey, a2 / 2.0, b2 / 2.0,
+                                        math.cos(t), math.sin(t), float(blur_sigma_px),
+                                        float(c[0]), float(c[1]))  # fmt: skip
     n_out = int((~inl).sum())
     theta, r = theta[inl], r[inl]
     r_mean = float(np.mean(r))

@@ -38,7 +38,7 @@ from measure.image_input import (
     to_gray,
     to_search_image,
 )
-from measure.outline import disc_like, without_bites
+from measure.outline import disc_like, outline_prefilter, without_bites
 
 __all__ = [
     "SEARCH_SCALE",
@@ -117,26 +117,19 @@ def _discs(
     contours, _ = cv2.findContours(
         mask.view(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE, offset=offset
     )
-    min_len = max(8, int(2.0 * np.sqrt(np.pi * min_area)))  # 2√(π A) ≈ the disc's perimeter
+    min_len = max(8, int(2.0 * math.sqrt(math.pi * min_area)))  # 2√(π A): a disc's perimeter
     out = []
-    lengths = np.fromiter(map(len, contours), dtype=np.intp, count=len(contours))
-    for i in np.flatnonzero(lengths >= min_len):
-        c = contours[i]
-        x, y, w, h = cv2.boundingRect(c)
-        if w * h < min_area:
-            continue
-        border = x == 0 or y == 0 or x + w == W or y + h == H
-        if border != border_only:
-            continue
-        area = cv2.contourArea(c)  # = the moments' m00 (integer vertices: exact)
-        if area < min_area or area > 0.5 * H * W:
-            continue
-        if not border and (
-            area < 0.5 * w * h
-            or min(w, h) < 0.3 * max(w, h)
-            or 4.0 * math.pi * area < 0.45 * len(c) ** 2  # ragged: a disc's is about 0.8
-        ):
-            continue
+    sel = [c for c in contours if len(c) >= min_len]
+    if not sel:
+        return out
+    lengths = np.fromiter(map(len, sel), dtype=np.intp, count=len(sel))
+    starts = np.cumsum(lengths) - lengths
+    pts = (np.concatenate(sel) if len(sel) > 1 else sel[0]).reshape(-1, 2)
+    ok, boxes, borders = outline_prefilter(pts, starts, (H, W), float(min_area), border_only)
+    for j in np.flatnonzero(ok):
+        c = sel[j]
+        x, y, w, h = (int(v) for v in boxes[j])
+        border = bool(borders[j])
         if reach(x, y, w, h) < 0.5:
             continue
         if tally is not None:

@@ -22,7 +22,13 @@ import cv2
 import numpy as np
 
 from measure.detect import HoleCandidate
-from measure.masks import above, below, grow_box, ring_mask
+from measure.edge_kernels import (
+    binary_moments,
+    parabola_points,
+    ring_histogram,
+    scaled_int16,
+)
+from measure.masks import above, below, grow_box, ring_bounds, ring_mask
 from measure.outline import without_bites
 from measure.slope import slope_shift
 
@@ -47,6 +53,7 @@ class HoleRegion:
     inside_level: float = 0.0
     outside_level: float = 0.0
     ring_level: float = 0.0
+    box: tuple[int, int, int, int] | None = None  # the mask's bounding box, ROI pixels
 
 
 @dataclass(frozen=True)
@@ -69,6 +76,21 @@ def _median(img: np.ndarray, mask: np.ndarray, full: float) -> float | None:
     or bool mask), from a histogram; ``None`` when no pixel is masked."""
     bins = 256 if img.dtype == np.uint8 else 1024
     hist = cv2.calcHist([img], [0], mask.view(np.uint8), [bins], [0, full + 1]).ravel()
+    return _hist_median(hist, bins, full)
+
+
+def _ring_median(img: np.ndarray, dist: np.ndarray, inner: float, outer: float, full: float):
+    """:func:`_median` of the pixels ``inner`` (exclusive) … ``outer`` px outside the
+    region (:func:`measure.masks.ring_mask` of its distance map ``dist``); for 8-bit
+    images one compiled pass (:func:`measure.edge_kernels.ring_histogram`)."""
+    if img.dtype != np.uint8:
+        return _median(img, ring_mask(dist, inner, outer), full)
+    lo, hi = ring_bounds(inner, outer)
+    return _hist_median(ring_histogram(img, dist, lo, hi).astype(np.float32), 256, full)
+
+
+def _hist_median(hist: np.ndarray, bins: int, full: float) -> float | None:
+    """The median's gray level (fraction of full scale) from float32 histogram counts."""
     cdf = np.cumsum(hist)
     if cdf[-1] <= 0:
         return None
@@ -105,6 +127,14 @@ def _region(mask: np.ndarray, seed: tuple[float, float]) -> tuple[np.ndarray, Bo
                 cv2.ellipse(region, ell, 1, thickness=cv2.FILLED)
                 box = cv2.boundingRect(region)
     return region, box
+
+
+def _count(mask: np.ndarray, box: tuple[int, int, int, int] | None) -> float:
+    """Set pixels of ``mask``, all of which lie in ``box`` (x, y, w, h)."""
+    if box is None:
+        return 0.0
+    x, y, w, h = box
+    return float(cv2.countNonZero(mask[y : y + h, x : x + w]))
 
 
 def hole_region(
@@ -145,15 +175,14 @@ def hole_region(
     if rbox is not None:
         k = max(4, int(0.03 * cand.diameter_px))
         ker = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
-        ys, xs, _, _ = grow_box(rbox, 3, region.shape)  # the kernel's reach: zeros round the box
-        core = np.zeros(region.shape, np.uint8)
-        core[ys, xs] = cv2.erode(region[ys, xs], ker)
+        cys, cxs, _, _ = grow_box(rbox, 3, region.shape)  # the kernel's reach: zeros round it
+        core = cv2.erode(region[cys, cxs], ker)  # (zero outside that box)
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
         ys, xs, _, _ = grow_box(rbox, 5 + 2 * k, region.shape)  # holds the ring 3 … 3 + k px
-        lout = _median(roi_img[ys, xs], ring_mask(dist[ys, xs], 3, 3 + k), full)
+        lout = _ring_median(roi_img[ys, xs], dist[ys, xs], 3, 3 + k, full)
         if not dark and lout is not None:  # the lit part only, not the wall crescent
-            core &= above(roi_img, lout * full)
-        lin = _median(roi_img, core, full)
+            core &= above(roi_img[cys, cxs], lout * full)
+        lin = _median(roi_img[cys, cxs], core, full)
         if lin is not None and lout is not None and (lin < lout) == dark:
             inside, outside = lin, lout
             level = 0.5 * (lin + lout)
@@ -162,31 +191,33 @@ def hole_region(
             else:  # a lit background: the bore wall seen at a tilt is a dark crescent
                 mask = above(roi_img, level * full) | (roi_img < (2 * lout - level) * full)
             refined, fbox = _region(mask, seed)
-            ratio = float(cv2.countNonZero(refined)) / float(cv2.countNonZero(region))
+            ratio = _count(refined, fbox) / _count(region, rbox)
             # the same region, better placed; else keep the first (moved by a pixel or two:
             # the first distance map serves)
             if 0.6 < ratio < 1.6:
                 region, rbox = refined, fbox
+    mask = region.view(bool)  # 0/1
     if rbox is None:
-        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
+        return HoleRegion(box, (cx, cy), 0.0, mask, level, inside, outside, outside)
     bx, by = rbox[:2]
-    mom = cv2.moments(region[by : by + rbox[3], bx : bx + rbox[2]], binaryImage=True)
-    if mom["m00"] <= 0:
-        return HoleRegion(box, (cx, cy), 0.0, region > 0, level, inside, outside, outside)
-    centroid = (mom["m10"] / mom["m00"] + bx + x0, mom["m01"] / mom["m00"] + by + y0)
-    d = 2.0 * np.sqrt(mom["m00"] / np.pi)
+    m00, m10, m01 = binary_moments(region[by : by + rbox[3], bx : bx + rbox[2]])
+    if m00 <= 0:
+        return HoleRegion(box, (cx, cy), 0.0, mask, level, inside, outside, outside, rbox)
+    centroid = (m10 / m00 + bx + x0, m01 / m00 + by + y0)
+    d = 2.0 * np.sqrt(m00 / np.pi)
     if dist is None:
         dist = cv2.distanceTransform(cv2.compare(region, 0, cv2.CMP_EQ), cv2.DIST_L2, 3)
-    wide = _median(roi_img, ring_mask(dist, 0.05 * d, 0.2 * d), full)
+    wide = _ring_median(roi_img, dist, 0.05 * d, 0.2 * d, full)
     return HoleRegion(
         box,
         centroid,
-        float(mom["m00"]),
-        region > 0,
+        m00,
+        mask,
         level,
         inside,
         outside,
         outside if wide is None else wide,
+        rbox,
     )
 
 
@@ -243,11 +274,12 @@ def gradient_kernels(sigma_px: float, full: float) -> tuple[np.ndarray, np.ndarr
 _CROP_MARGIN_PX = 7
 
 
-def _edge_crop(mask: np.ndarray, band_px: int) -> tuple[int, int, int, int]:
-    """(x0, y0, x1, y1) of the ROI part the edge step needs: the outline band and its reach."""
-    bx, by, bw, bh = cv2.boundingRect(mask.view(np.uint8))
+def _edge_crop(box, shape, band_px: int) -> tuple[int, int, int, int]:
+    """(x0, y0, x1, y1) of the ROI part the edge step needs: the outline band and its
+    reach, from the region's box (x, y, w, h) in the ROI of ``shape`` (h, w)."""
+    bx, by, bw, bh = box
     m = band_px + _CROP_MARGIN_PX
-    H, W = mask.shape
+    H, W = shape
     return max(bx - m, 0), max(by - m, 0), min(bx + bw + m, W), min(by + bh + m, H)
 
 
@@ -269,10 +301,10 @@ def subpixel_edges(
     """
     if method not in EDGE_METHODS:
         raise ValueError(f"edge method must be one of {EDGE_METHODS}, got {method!r}")
-    if not region.mask.any():
+    if region.box is None:
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
     rx, ry = region.roi[:2]
-    cx0, cy0, cx1, cy1 = _edge_crop(region.mask, 3)
+    cx0, cy0, cx1, cy1 = _edge_crop(region.box, region.mask.shape, 3)
     x0, y0, w, h = rx + cx0, ry + cy0, cx1 - cx0, cy1 - cy0
     sub = img[y0 : y0 + h, x0 : x0 + w]
     kd, ks = gradient_kernels(float(sigma_px), float(full))
@@ -287,8 +319,7 @@ def subpixel_edges(
     if peak <= 0:
         return EdgePoints(np.zeros((0, 2)), np.zeros(0))
     scale = np.float32(16000.0 / max(float(mag.max()), 1e-12))  # |g| ≤ max: no clipping
-    dx = (gx * scale).astype(np.int16)
-    dy = (gy * scale).astype(np.int16)
+    dx, dy = scaled_int16(gx, gy, scale)
     hi = 0.35 * peak * float(scale)
     edges = cv2.Canny(dx, dy, 0.5 * hi, hi, L2gradient=True)
     found = cv2.findNonZero(cv2.bitwise_and(edges, band))  # row by row, as np.nonzero
@@ -298,25 +329,13 @@ def subpixel_edges(
     xs, ys = found[:, 0], found[:, 1]
     keep = (xs >= 3) & (ys >= 3) & (xs < w - 3) & (ys < h - 3)
     xs, ys = xs[keep], ys[keep]
-    gxs, gys = gx[ys, xs], gy[ys, xs]
-    horiz = np.abs(gxs) >= np.abs(gys)
-    sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
-    # the gradient magnitude at each pixel and its two neighbours along the dominant axis
-    g0 = mag[ys, xs].astype(np.float64)
-    gm = mag[ys - sy, xs - sx].astype(np.float64)
-    gp = mag[ys + sy, xs + sx].astype(np.float64)
     if method == "parabola":
-        off, ok = _parabola(gm, g0, gp)
+        pts, strength, _, _, widths, normals = parabola_points(xs, ys, gx, gy, mag)
     else:
-        raw = sub.astype(np.float32) * np.float32(1.0 / full)
-        off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
-    pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
-    gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
-    widths = _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
+        pts, strength, widths = _linear_points(sub, full, gx, gy, mag, xs, ys)
     finite = widths[np.isfinite(widths)]
     blur = _percentile(finite, 50.0) if len(finite) else 0.0
     if slope_correction and method == "parabola" and len(pts):
-        normals = np.stack([gxs, gys], axis=1) / np.maximum(strength, 1e-12)[:, None]
         centre = (region.centroid_px[0] - x0, region.centroid_px[1] - y0)
         shift = slope_shift(gx, gy, pts, normals, strength, blur, centre)
         pts -= shift[:, None] * normals
@@ -326,6 +345,23 @@ def subpixel_edges(
         blur_sigma_px=blur,
         width_px=widths,
     )
+
+
+def _linear_points(sub, full, gx, gy, mag, xs, ys):
+    """The linear method's points (M, 2), and per point the gradient magnitude and the
+    edge width (as :func:`measure.edge_kernels.parabola_points` gives them)."""
+    gxs, gys = gx[ys, xs], gy[ys, xs]
+    horiz = np.abs(gxs) >= np.abs(gys)
+    sx, sy = horiz.astype(np.intp), (~horiz).astype(np.intp)
+    # the gradient magnitude at each pixel and its two neighbours along the dominant axis
+    g0 = mag[ys, xs].astype(np.float64)
+    gm = mag[ys - sy, xs - sx].astype(np.float64)
+    gp = mag[ys + sy, xs + sx].astype(np.float64)
+    raw = sub.astype(np.float32) * np.float32(1.0 / full)
+    off, ok = _linear(raw, gx, gy, xs, ys, sx, sy)
+    pts = np.stack([xs + off * sx, ys + off * sy], axis=1)[ok].astype(np.float64)
+    gxs, gys, strength = gxs[ok], gys[ok], g0[ok]
+    return pts, strength, _edge_widths(gm[ok], strength, gp[ok], gxs, gys, horiz[ok])
 
 
 def _edge_widths(gm, g0, gp, gxs, gys, horiz) -> np.ndarray:
@@ -338,17 +374,6 @@ def _edge_widths(gm, g0, gp, gxs, gys, horiz) -> np.ndarray:
     along = np.where(horiz, np.abs(gxs), np.abs(gys)) / g
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(curv < 0, np.sqrt(-1.0 / curv) * along, np.inf)
-
-
-def _parabola(gm, g0, gp) -> tuple[np.ndarray, np.ndarray]:
-    """Vertex offset (px, along the dominant axis) of the parabola through the magnitudes
-    before, at and after each pixel, and where it is a maximum within half a pixel."""
-    den = gm - 2.0 * g0 + gp
-    ok = (den < 0) & (g0 >= gm) & (g0 >= gp)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        off = np.where(ok, 0.5 * (gm - gp) / den, 0.0)
-    ok &= np.abs(off) <= 0.5
-    return off, ok
 
 
 def _linear(raw, gx, gy, xs, ys, sx, sy) -> tuple[np.ndarray, np.ndarray]:

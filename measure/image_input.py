@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 
 from measure.errors import ImageError
+from measure.image_kernels import histogram_u8
 
 #: downsampling factor of the search image
 SEARCH_SCALE = 4
@@ -73,7 +74,7 @@ def full_scale(img: np.ndarray) -> float:
 
 def quantiles_u8(img: np.ndarray, qs: tuple[float, ...]) -> list[float]:
     """Quantiles (0..1) of a uint8 image from its histogram (far cheaper than sorting)."""
-    hist = cv2.calcHist([img], [0], None, [256], [0, 256]).ravel()
+    hist = histogram_u8(np.ascontiguousarray(img)).astype(np.float32)  # as cv2.calcHist's
     cdf = np.cumsum(hist) / img.size
     return [float(np.searchsorted(cdf, q)) for q in qs]
 
@@ -101,7 +102,7 @@ def check_image(img: np.ndarray, which: str) -> tuple[float, np.ndarray]:
     full = full_scale(img)
     small = to_search_image(img, full)
     n = small.size
-    hist = cv2.calcHist([small], [0], None, [256], [0, 256]).ravel()
+    hist = histogram_u8(small).astype(np.float32)  # as cv2.calcHist's
     n_sat = int(hist[254:].sum())
     if n_sat > 0.5 * n:
         raise ImageError(

@@ -19,10 +19,16 @@ def _f32_at_most(x: float) -> np.float32:
     return f if float(f) <= x else np.nextafter(f, np.float32(-np.inf))
 
 
+def ring_bounds(inner: float, outer: float) -> tuple[np.float32, np.float32]:
+    """The float32 bounds [lo, hi] of the distances ``inner`` (exclusive) … ``outer``."""
+    return _f32_above(inner), _f32_at_most(outer)
+
+
 def ring_mask(outside_px: np.ndarray, inner: float, outer: float) -> np.ndarray:
     """Pixels between ``inner`` (exclusive) and ``outer`` px outside the region, from its
     float32 distance map, as a 0/255 ``uint8`` mask (one ``cv2.inRange`` pass)."""
-    return cv2.inRange(outside_px, float(_f32_above(inner)), float(_f32_at_most(outer)))
+    lo, hi = ring_bounds(inner, outer)
+    return cv2.inRange(outside_px, float(lo), float(hi))
 
 
 def below(img: np.ndarray, level: float) -> np.ndarray:

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from measure.match_kernels import match_flank
+
 
 @dataclass(frozen=True)
 class Matches:
@@ -38,7 +40,7 @@ def _flanks(pts: np.ndarray) -> list[np.ndarray]:
     i_top, i_bot = int(np.argmin(pts[:, 1])), int(np.argmax(pts[:, 1]))
     a = (i_top + np.arange((i_bot - i_top) % n + 1)) % n
     b = (i_bot + np.arange((i_top - i_bot) % n + 1)) % n
-    b = b[::-1]  # also top → bottom
+    b = np.ascontiguousarray(b[::-1])  # also top → bottom (contiguous: one compiled variant)
     return [a, b] if pts[a, 0].mean() <= pts[b, 0].mean() else [b, a]
 
 
@@ -56,26 +58,15 @@ def _one_way(src, src_w, src_f, dst, dst_w, dst_f, steep_src, steep_dst, flanks_
     their :func:`_steep` masks and :func:`_flanks` given)."""
     out_x, out_w, out_f, out_i = [], [], [], []
     for fs, fd in zip(flanks_src, flanks_dst, strict=True):
-        yd = dst[fd, 1]
-        mono = np.concatenate([[True], np.diff(yd) > 0])
-        fd = fd[mono]
-        if len(fd) < 4:
+        x, ys, w, f, i, ok = match_flank(
+            src, fs, dst, fd, steep_src, steep_dst, src_w, dst_w, src_f, dst_f
+        )
+        if not ok:
             continue
-        yd, xd = dst[fd, 1], dst[fd, 0]
-        ys = src[fs, 1]
-        k = np.searchsorted(yd, ys)
-        inside = (k > 0) & (k < len(yd))
-        k = np.clip(k, 1, len(yd) - 1)
-        lo, hi = fd[k - 1], fd[k]
-        a = (ys - yd[k - 1]) / np.maximum(yd[k] - yd[k - 1], 1e-12)
-        x = xd[k - 1] + a * (xd[k] - xd[k - 1])
-        ok = inside & steep_src[fs] & steep_dst[lo] & steep_dst[hi]
-        w = src_w[fs] * np.minimum(dst_w[lo], dst_w[hi])
-        f = src_f[fs] | dst_f[lo] | dst_f[hi]
-        out_x.append(np.stack([x, ys], axis=1)[ok])
-        out_w.append(w[ok])
-        out_f.append(f[ok])
-        out_i.append(fs[ok])
+        out_x.append(np.stack([x, ys], axis=1))
+        out_w.append(w)
+        out_f.append(f)
+        out_i.append(i)
     if not out_x:
         return np.zeros((0, 2)), np.zeros(0), np.zeros(0, bool), np.zeros(0, int)
     return (

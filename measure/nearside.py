@@ -29,6 +29,7 @@ from dataclasses import replace
 import numpy as np
 
 from measure.circle import Circle3D, _sigma, fit_circle_3d
+from measure.circle_kernels import off_sectors, rim_view_angles_max
 
 #: fewer safe points than this fraction of the usable ones: the check is skipped
 MIN_SAFE_FRACTION = 0.4
@@ -81,15 +82,15 @@ def _off_sectors(
     systematic offset, not noise (the median of a sector's dozens of points has a small
     fraction of the points' spread).
     """
-    out = np.zeros(len(h), dtype=bool)
-    k = np.floor((phi + np.pi) / np.deg2rad(SECTOR_DEG)).astype(int)
-    for b in np.unique(k[mask]):
-        sel = mask & (k == b)
-        if sel.sum() < SECTOR_MIN_POINTS:
-            continue
-        if np.hypot(np.median(h[sel]), np.median(dr[sel])) > SECTOR_LIMIT_SIGMA * sigma:
-            out |= sel
-    return out
+    k = np.floor((phi + np.pi) / np.deg2rad(SECTOR_DEG)).astype(np.int64)
+    return off_sectors(
+        np.ascontiguousarray(h, np.float64),
+        np.ascontiguousarray(dr, np.float64),
+        k,
+        np.ascontiguousarray(mask, np.bool_),
+        SECTOR_MIN_POINTS,
+        SECTOR_LIMIT_SIGMA * sigma,
+    )
 
 
 def fit_with_near_side_check(
@@ -118,7 +119,12 @@ def fit_with_near_side_check(
     kw = {"cost": cost, "reject_sigma": reject_sigma, "min_reject_m": min_reject_m}
     plain = fit_circle_3d(points, w, **kw)
     usable = (w > 0) & np.all(np.isfinite(points), axis=1)
-    ang = rim_view_angles(points, plain.center, plain.normal, cameras).max(axis=1)
+    ang = rim_view_angles_max(
+        np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3),
+        np.asarray(plain.center, dtype=np.float64).reshape(3),
+        np.asarray(plain.normal, dtype=np.float64).reshape(3),
+        np.ascontiguousarray(cameras, dtype=np.float64).reshape(-1, 3),
+    )
     suspect = usable & (ang > np.deg2rad(max_angle_deg))
     # the reference: the plain fit's inliers off the suspect sectors (the plain fit has
     # already rejected burrs and false edges), refitted from the plain fit

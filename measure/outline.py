@@ -78,3 +78,46 @@ def _ellipse_fit(pts, cx, cy, c, s, ia, ib, tol):
         if rel[i] < tol:
             within += 1
     return np.median(rel), within
+
+
+@njit(cache=True)
+def outline_prefilter(pts, starts, shape, min_area, border_only):
+    """The cheap tests of :func:`measure.detect._discs` on outlines concatenated in
+    ``pts`` (M, 2) (outline k: rows ``starts[k]`` … ``starts[k + 1]``; the last runs to
+    the end): box, border contact and area (``cv2.boundingRect`` and ``cv2.contourArea``;
+    integer vertices, so the same values) and, away from the border, compactness.
+    Returns which pass, their boxes (x, y, w, h) and whether each touches the border."""
+    H, W = shape
+    n = starts.shape[0]
+    ok = np.zeros(n, np.bool_)
+    boxes = np.zeros((n, 4), np.int64)
+    border = np.zeros(n, np.bool_)
+    for k in range(n):
+        s = starts[k]
+        e = starts[k + 1] if k + 1 < n else pts.shape[0]
+        x0, y0, x1, y1 = pts[s, 0], pts[s, 1], pts[s, 0], pts[s, 1]
+        a00 = 0.0
+        px, py = np.float64(pts[e - 1, 0]), np.float64(pts[e - 1, 1])
+        for i in range(s, e):
+            x, y = pts[i, 0], pts[i, 1]
+            x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
+            a00 += px * y - py * x
+            px, py = np.float64(x), np.float64(y)
+        w, h = x1 - x0 + 1, y1 - y0 + 1
+        boxes[k, 0], boxes[k, 1], boxes[k, 2], boxes[k, 3] = x0, y0, w, h
+        if w * h < min_area:
+            continue
+        border[k] = x0 == 0 or y0 == 0 or x0 + w == W or y0 + h == H
+        if border[k] != border_only:
+            continue
+        area = abs(a00 * 0.5)
+        if area < min_area or area > 0.5 * H * W:
+            continue
+        if not border[k] and (
+            area < 0.5 * w * h
+            or min(w, h) < 0.3 * max(w, h)
+            or 4.0 * math.pi * area < 0.45 * (e - s) ** 2  # ragged: a disc's is about 0.8
+        ):
+            continue
+        ok[k] = True
+    return ok, boxes, border

@@ -41,7 +41,8 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from scipy.ndimage import median_filter
+
+from measure.edge_kernels import periodic_median, slope_offsets, slope_queries
 
 #: the inside slope is read this many blur σ from the edge point
 SLOPE_OFFSET_SIGMA = 3.0
@@ -51,13 +52,6 @@ SMOOTH_POINTS = 15
 MAX_SHIFT_PX = 0.5
 
 
-def _sample(a: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Bilinear samples of the float32 image ``a`` at points ``q`` (N, 2), x and y in px."""
-    qx = q[:, 0].astype(np.float32).reshape(-1, 1)
-    qy = q[:, 1].astype(np.float32).reshape(-1, 1)
-    return cv2.remap(a, qx, qy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).ravel()
-
-
 def _running_median(values: np.ndarray, angles: np.ndarray, window: int) -> np.ndarray:
     """Periodic running median of ``values`` ordered by ``angles`` (returned in input order)."""
     n = len(values)
@@ -65,7 +59,7 @@ def _running_median(values: np.ndarray, angles: np.ndarray, window: int) -> np.n
         return values
     order = np.argsort(angles)
     out = np.empty(n)
-    out[order] = median_filter(values[order], size=window, mode="wrap")
+    out[order] = periodic_median(np.ascontiguousarray(values[order], np.float64), window)
     return out
 
 
@@ -95,16 +89,14 @@ def slope_shift(
     n = len(points_px)
     if n == 0 or not np.isfinite(sigma_px) or sigma_px <= 0:
         return np.zeros(n)
-    inward = np.einsum("ij,ij->i", np.asarray(center_px) - points_px, normals) > 0
-    side = np.where(inward, 1.0, -1.0)  # +1: the gradient points into the hole
-    q = points_px + (side * SLOPE_OFFSET_SIGMA * sigma_px)[:, None] * normals
-    s_inside = _sample(gx, q) * normals[:, 0] + _sample(gy, q) * normals[:, 1]
-    s_inside -= peak * np.exp(-0.5 * SLOPE_OFFSET_SIGMA**2)  # the step's own Gaussian tail
-    s_plus = np.where(inward, s_inside, 0.0)
-    s_minus = np.where(inward, 0.0, s_inside)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = (s_plus - s_minus) * sigma_px / (np.sqrt(2.0 * np.pi) * peak)
-    x = np.where(np.isfinite(x), x, 0.0)
-    d = points_px - np.asarray(center_px, dtype=np.float64)
-    x = _running_median(x, np.arctan2(d[:, 1], d[:, 0]), SMOOTH_POINTS)
+    centre = np.asarray(center_px, dtype=np.float64)
+    pts = np.ascontiguousarray(points_px, dtype=np.float64)
+    nrm = np.ascontiguousarray(normals, dtype=np.float64)
+    inward, qx, qy, angles = slope_queries(pts, nrm, centre, SLOPE_OFFSET_SIGMA * sigma_px)
+    sx = cv2.remap(gx, qx, qy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).ravel()
+    sy = cv2.remap(gy, qx, qy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).ravel()
+    tail = np.exp(-0.5 * SLOPE_OFFSET_SIGMA**2)  # the step's own Gaussian tail
+    peak = np.ascontiguousarray(peak, dtype=np.float64)
+    x = slope_offsets(sx, sy, nrm, peak, inward, tail, float(sigma_px))
+    x = _running_median(x, angles, SMOOTH_POINTS)
     return np.where(np.abs(x) <= MAX_SHIFT_PX, x, 0.0)
