@@ -23,7 +23,8 @@ _cache: OrderedDict[bytes, tuple[np.ndarray, np.ndarray]] = OrderedDict()
 _lock = threading.Lock()
 
 
-def _key(stereo: StereoCalibration, side: str) -> bytes:
+def pixel_rays_key(stereo: StereoCalibration, side: str) -> bytes:
+    """What identifies camera ``side``'s rays: its intrinsics, distortion and image size."""
     K, d = (
         (stereo.K_left, stereo.dist_left) if side == "left" else (stereo.K_right, stereo.dist_right)
     )
@@ -53,7 +54,7 @@ def pixel_rays(stereo: StereoCalibration, side: str) -> tuple[np.ndarray, np.nda
     centre of camera ``side`` ("left" or "right"); cached per camera model."""
     if side not in ("left", "right"):
         raise ValueError(f"side must be 'left' or 'right', got {side!r}")
-    key = _key(stereo, side)
+    key = pixel_rays_key(stereo, side)
     with _lock:
         hit = _cache.get(key)
         if hit is not None:
