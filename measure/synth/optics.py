@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 
 from measure.calibration import StereoCalibration
+from measure.synth.pixel_rays import pixel_rays_key
 
 
 @dataclass(frozen=True)
@@ -56,6 +59,32 @@ def ray_grid(
         nx=norm[:, 0].reshape(rows, cols),
         ny=norm[:, 1].reshape(rows, cols),
     )
+
+
+#: how many cameras' full-frame ray grids :func:`frame_ray_grid` keeps
+CACHE_GRIDS = 8
+_grids: OrderedDict[tuple, RayGrid] = OrderedDict()
+_lock = threading.Lock()
+
+
+def frame_ray_grid(stereo: StereoCalibration, side: str, step: float) -> RayGrid:
+    """``ray_grid(stereo, side, 0, 0, w, h, step)`` over the whole image, cached per camera
+    model (read-only arrays): every render of a camera asks for the same one."""
+    w, h = stereo.image_size
+    key = (pixel_rays_key(stereo, side), float(step))
+    with _lock:
+        hit = _grids.get(key)
+        if hit is not None:
+            _grids.move_to_end(key)
+            return hit
+    grid = ray_grid(stereo, side, 0.0, 0.0, w, h, step)
+    grid.nx.setflags(write=False)
+    grid.ny.setflags(write=False)
+    with _lock:
+        _grids[key] = grid
+        while len(_grids) > CACHE_GRIDS:
+            _grids.popitem(last=False)
+    return grid
 
 
 def vignetting(

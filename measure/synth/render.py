@@ -19,7 +19,8 @@ import numpy as np
 from measure.calibration import StereoCalibration
 from measure.synth.hole_scene import HoleGeometry, Shading, shade
 from measure.synth.marker_draw import MarkerPatch, draw_markers
-from measure.synth.optics import ray_grid, vignetting
+from measure.synth.optics import frame_ray_grid, ray_grid, vignetting
+from measure.synth.sensor import finish_region
 from measure.synth.texture import TEXEL_M, TILE_CENTER_M, background_noise, sample_texture
 
 
@@ -131,7 +132,7 @@ def _background(
     """
     w, h = stereo.image_size
     step = 16.0
-    grid = ray_grid(stereo, side, 0.0, 0.0, w, h, step)
+    grid = frame_ray_grid(stereo, side, step)
     x, y = geo.plane_hit(grid.nx, grid.ny)
     K = stereo.K_left if side == "left" else stereo.K_right
     gy, gx = np.mgrid[0 : grid.nx.shape[0], 0 : grid.nx.shape[1]]
@@ -215,25 +216,27 @@ def _render_window(
 
 
 def _finish(img: np.ndarray, opts: RenderOptions, win, rng: np.random.Generator) -> np.ndarray:
-    """Scale to gray levels, add shot and read noise (fresh in the window), quantise."""
+    """Scale to gray levels, add shot and read noise (fresh in the window), quantise. Read
+    noise alone (the default) takes one compiled pass (:func:`finish_region`); ``img`` may be
+    overwritten."""
     full = 255.0 if opts.bit_depth == 8 else 4095.0
-    dn = img
-    dn *= np.float32(full)
-    bank = background_noise(dn.shape, rng)
+    bank = background_noise(img.shape, rng)
     x0, y0, w, h = win
     fresh = rng.standard_normal((h, w), dtype=np.float32) if w > 0 and h > 0 else None
-    if opts.full_well_e:
-        gain = np.float32(full / opts.full_well_e)
-        sigma = np.sqrt(np.float32(opts.read_noise_dn**2) + np.maximum(dn, 0) * gain)
-        noise = sigma * bank
-        if fresh is not None:
-            noise[y0 : y0 + h, x0 : x0 + w] = sigma[y0 : y0 + h, x0 : x0 + w] * fresh
-        dn += noise
-    elif opts.read_noise_dn > 0:
-        read = np.float32(opts.read_noise_dn)
-        dn += read * bank
-        if fresh is not None:  # the measured region gets noise of its own
-            dn[y0 : y0 + h, x0 : x0 + w] += read * (fresh - bank[y0 : y0 + h, x0 : x0 + w])
+    if not opts.full_well_e:
+        read = np.float32(opts.read_noise_dn if opts.read_noise_dn > 0 else 0.0)
+        out = np.empty(img.shape, dtype=np.uint8 if opts.bit_depth == 8 else np.uint16)
+        fr = fresh if fresh is not None else np.zeros((0, 0), dtype=np.float32)
+        finish_region(img, np.float32(full), read, bank, fr, x0, y0, int(full), 0, 0, out)
+        return out
+    dn = img
+    dn *= np.float32(full)
+    gain = np.float32(full / opts.full_well_e)
+    sigma = np.sqrt(np.float32(opts.read_noise_dn**2) + np.maximum(dn, 0) * gain)
+    noise = sigma * bank
+    if fresh is not None:
+        noise[y0 : y0 + h, x0 : x0 + w] = sigma[y0 : y0 + h, x0 : x0 + w] * fresh
+    dn += noise
     np.maximum(dn, 0.0, out=dn)
     if opts.bit_depth == 8:
         return cv2.convertScaleAbs(dn)  # rounds and saturates at 255

@@ -38,6 +38,16 @@ def quantize_u8(src, noise, x0, y0, out) -> None:
                 o[j] = _u8(max(s[j], zero))
 
 
+@njit(cache=True, inline="always")
+def _level(v, full: int):
+    """A value (float32, DN) clipped at 0 and quantised: ``uint8`` as OpenCV's
+    ``convertScaleAbs`` (``full`` = 255), else ``uint16`` truncating ``v + 0.5`` below ``full``."""
+    v = max(v, np.float32(0.0))
+    if full == 255:
+        return np.uint16(_u8(v))
+    return np.uint16(min(v, np.float32(full)) + np.float32(0.5))
+
+
 @njit(cache=True)
 def finish_region(src, scale, read, bank, fresh, wx0, wy0, full, x0, y0, out) -> None:
     """The camera output of ``src`` ((h, w) float32, fraction of full scale) at pixels
@@ -48,24 +58,20 @@ def finish_region(src, scale, read, bank, fresh, wx0, wy0, full, x0, y0, out) ->
     ``full`` (255 or 4095). ``read`` = 0: no noise (``bank`` may then be empty)."""
     h, w = src.shape
     fh, fw = fresh.shape
-    zero = np.float32(0.0)
-    top = np.float32(full)
     noisy = read != 0.0
     for i in range(h):
         yy = y0 + i
-        for j in range(w):
-            xx = x0 + j
-            v = src[i, j] * scale
-            if noisy:
-                b = bank[yy, xx]
-                v = v + read * b
-                if wy0 <= yy < wy0 + fh and wx0 <= xx < wx0 + fw:
-                    v = v + read * (fresh[yy - wy0, xx - wx0] - b)
-            if v < zero:
-                v = zero
-            if full == 255:
-                out[yy, xx] = _u8(v)
-            else:
-                if v > top:
-                    v = top
-                out[yy, xx] = np.uint16(v + np.float32(0.5))
+        s, o = src[i], out[yy, x0 : x0 + w]
+        if noisy:
+            b = bank[yy, x0 : x0 + w]
+            for j in range(w):
+                o[j] = _level(s[j] * scale + read * b[j], full)
+            if wy0 <= yy < wy0 + fh:  # the window: its own noise
+                j0, j1 = max(wx0 - x0, 0), min(wx0 + fw - x0, w)
+                f = fresh[yy - wy0]
+                for j in range(j0, j1):
+                    v = s[j] * scale + read * b[j]
+                    o[j] = _level(v + read * (f[x0 + j - wx0] - b[j]), full)
+        else:
+            for j in range(w):
+                o[j] = _level(s[j] * scale, full)
