@@ -97,11 +97,17 @@ def _light(stereo: StereoCalibration, side: str, vignetting: float, gain: float)
     return np.array([gain, vignetting, cx, cy, rc2])
 
 
-def _plate_args(stereo, side, R, t, spec, vignetting, gain):
-    """The arguments of :func:`plate_region` but the region and the output."""
+def _plate_args(stereo, side, R, t, spec, vignetting, gain, blur=None):
+    """The arguments of :func:`plate_region` but the region and the output; the rays are
+    valid over the whole image, or (``blur`` given) over the rows :func:`_region` asks for."""
     light = _light(stereo, side, vignetting, gain)
     box = plate_box(stereo, side, R, t, spec) or (0, 0, 0, 0)
-    nx, ny = pixel_rays(stereo, side)
+    rows = None
+    if blur is not None:
+        w, h = stereo.image_size
+        (_, y0, _, y1), _ = _region(box, blur, w, h)
+        rows = (y0 - 1, y1 + 1) if box[2] > box[0] and box[3] > box[1] else (0, 0)
+    nx, ny = pixel_rays(stereo, side, rows)
     lo, hi = spec.plate_bounds()
     bounds = np.array([lo[0], hi[0], lo[1], hi[1]]) / spec.pitch_m
     kind = CHESSBOARD if spec.kind == "chessboard" else CIRCLES
@@ -149,10 +155,11 @@ def _surround(stereo: StereoCalibration, side: str, blur: float) -> np.ndarray:
             _surrounds.move_to_end(key)
             return hit
     w, h = stereo.image_size
-    nx, ny = pixel_rays(stereo, side)
-    none = np.zeros(4, dtype=np.int64)  # no plate pixel: only the light matters
+    nx = np.zeros((1, 1), dtype=np.float32)  # no plate pixel: only the light matters, no ray
+    nx.setflags(write=False)
+    none = np.zeros(4, dtype=np.int64)
     img = np.empty((h, w), dtype=np.float32)
-    plate_image(nx, ny, none, np.eye(3), CHESSBOARD, 1.0, 1.0, 0.5, np.zeros(4),
+    plate_image(nx, nx, none, np.eye(3), CHESSBOARD, 1.0, 1.0, 0.5, np.zeros(4),
                 _light(stereo, side, VIGNETTING, 255.0), img)  # fmt: skip
     if blur > 0:
         img = cv2.GaussianBlur(img, (0, 0), blur)
@@ -181,7 +188,7 @@ def _render_side(stereo, side, R, t, spec, blur, noise, rng) -> np.ndarray:
     over the whole frame (OpenCV's generator, 5x numpy's speed at 5 MP, seeded per image from
     ``rng``), quantised to 8 bits."""
     w, h = stereo.image_size
-    args = _plate_args(stereo, side, R, t, spec, VIGNETTING, 255.0)
+    args = _plate_args(stereo, side, R, t, spec, VIGNETTING, 255.0, blur)
     base = _surround(stereo, side, blur)
     dn = np.empty((0, 0), dtype=np.float32)
     if noise > 0:
