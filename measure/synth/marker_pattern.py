@@ -201,7 +201,9 @@ def _ring_block(gnx, gny, gx0, gy0, step, box, H, geo, sectors, bx0, by0, bx1, b
 
 
 @njit(cache=True)
-def marker_patch(grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels, lit, out, spans):
+def marker_patch(
+    grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels, lit, out, spans, blocks=True
+):
     """Draw one marker into ``out`` ((h, w) float32: the pixels ``box`` = (x0, y0) onward,
     holding what lies behind the marker).
 
@@ -211,13 +213,14 @@ def marker_patch(grid, gx0, gy0, step, box, H, kind, geo, sectors, field, levels
     r_out, label_radius)``, tag ``(x_lo, x_hi, y_lo, y_hi, field_x0, field_top, cell)``.
     ``levels`` = (black, white) reflectance; ``lit`` ((h, w)): illumination. ``spans`` (h, 2):
     per row the columns ``[lo, hi)`` that can touch the label (the rest are left as they are).
-    A ring is drawn in blocks (:func:`_ring_block`): a block clear of every edge takes the
+    A ring is drawn in blocks (:func:`_ring_block`; ``blocks``, on a grid of ``RING_BLOCK_PX``
+    nodes and a box of ``RING_BLOCKS_FROM_PX`` or more): a block clear of every edge takes the
     value each of its pixels would get (the same image, bit for bit).
     """
     h, w = out.shape
     gnx, gny = grid[0], grid[1]
     black, white_level = levels[0], levels[1]
-    blocks = kind == RING and step == RING_BLOCK_PX and min(h, w) >= RING_BLOCKS_FROM_PX
+    blocks = blocks and kind == RING and step == RING_BLOCK_PX and min(h, w) >= RING_BLOCKS_FROM_PX
     B = RING_BLOCK_PX
     vals = np.full((w + B - 1) // B, PER_PIXEL)
     for yy in range(h):

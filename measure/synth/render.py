@@ -21,7 +21,7 @@ from measure.synth.hole_scene import HoleGeometry, Shading, shade
 from measure.synth.marker_draw import MarkerPatch, draw_markers
 from measure.synth.optics import frame_ray_grid, ray_grid, vignetting
 from measure.synth.sensor import finish_region
-from measure.synth.texture import TEXEL_M, TILE_CENTER_M, background_noise, sample_texture
+from measure.synth.texture import TEXEL_M, TILE_CENTER_M, background_noise_at, sample_texture
 
 
 @dataclass(frozen=True)
@@ -220,15 +220,18 @@ def _finish(img: np.ndarray, opts: RenderOptions, win, rng: np.random.Generator)
     noise alone (the default) takes one compiled pass (:func:`finish_region`); ``img`` may be
     overwritten."""
     full = 255.0 if opts.bit_depth == 8 else 4095.0
-    bank = background_noise(img.shape, rng)
+    bank, by0, bx0, flipped = background_noise_at(img.shape, rng)
     x0, y0, w, h = win
     fresh = rng.standard_normal((h, w), dtype=np.float32) if w > 0 and h > 0 else None
     if not opts.full_well_e:
         read = np.float32(opts.read_noise_dn if opts.read_noise_dn > 0 else 0.0)
         out = np.empty(img.shape, dtype=np.uint8 if opts.bit_depth == 8 else np.uint16)
         fr = fresh if fresh is not None else np.zeros((0, 0), dtype=np.float32)
-        finish_region(img, np.float32(full), read, bank, fr, x0, y0, int(full), 0, 0, out)
+        finish_region(np.ascontiguousarray(img), np.float32(full), read, bank, by0, bx0,
+                      flipped, fr, x0, y0, int(full), out)  # fmt: skip
         return out
+    bank = bank[by0 : by0 + img.shape[0], bx0 : bx0 + img.shape[1]]
+    bank = bank[::-1] if flipped else bank
     dn = img
     dn *= np.float32(full)
     gain = np.float32(full / opts.full_well_e)

@@ -49,29 +49,27 @@ def _level(v, full: int):
 
 
 @njit(cache=True)
-def finish_region(src, scale, read, bank, fresh, wx0, wy0, full, x0, y0, out) -> None:
-    """The camera output of ``src`` ((h, w) float32, fraction of full scale) at pixels
-    ``(x0, y0)`` onward of ``out`` ((H, W) uint8 or uint16): ``dn = src * scale`` (``scale``:
-    the full-scale level, float32), plus ``read * bank`` (``bank``: (H, W) unit noise of the
-    frame), plus, inside the window whose origin is ``(wx0, wy0)`` and whose shape is
-    ``fresh``'s, ``read * (fresh - bank)``; clipped at 0, rounded half to even and saturated at
-    ``full`` (255 or 4095). ``read`` = 0: no noise (``bank`` may then be empty)."""
+def finish_region(src, scale, read, bank, by0, bx0, flipped, fresh, wx0, wy0, full, out) -> None:
+    """The camera output of ``src`` ((H, W) float32, fraction of full scale) into ``out``
+    ((H, W) uint8 or uint16): ``dn = src * scale`` (``scale``: the full-scale level, float32),
+    plus ``read * b`` (``b``: the frame's unit noise, ``bank[by0 : by0 + H, bx0 : bx0 + W]``,
+    its rows reversed when ``flipped``), plus, inside the window whose origin is ``(wx0, wy0)``
+    and whose shape is ``fresh``'s, ``read * (fresh - b)``; clipped at 0, rounded half to even
+    and saturated at ``full`` (255 or 4095). ``read`` = 0: no noise (``bank`` unused)."""
     h, w = src.shape
     fh, fw = fresh.shape
     noisy = read != 0.0
-    for i in range(h):
-        yy = y0 + i
-        s, o = src[i], out[yy, x0 : x0 + w]
+    for yy in range(h):
+        s, o = src[yy], out[yy]
         if noisy:
-            b = bank[yy, x0 : x0 + w]
+            b = bank[by0 + (h - 1 - yy if flipped else yy), bx0 : bx0 + w]
             for j in range(w):
                 o[j] = _level(s[j] * scale + read * b[j], full)
             if wy0 <= yy < wy0 + fh:  # the window: its own noise
-                j0, j1 = max(wx0 - x0, 0), min(wx0 + fw - x0, w)
                 f = fresh[yy - wy0]
-                for j in range(j0, j1):
+                for j in range(max(wx0, 0), min(wx0 + fw, w)):
                     v = s[j] * scale + read * b[j]
-                    o[j] = _level(v + read * (f[x0 + j - wx0] - b[j]), full)
+                    o[j] = _level(v + read * (f[j - wx0] - b[j]), full)
         else:
             for j in range(w):
                 o[j] = _level(s[j] * scale, full)

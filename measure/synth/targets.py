@@ -11,6 +11,7 @@ point-sampling renderer as the reference.
 
 from __future__ import annotations
 
+import math
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -134,9 +135,10 @@ def render_plate(
     return out
 
 
-#: pixels of the frame a region's blur must reach past (the Gaussian's taps reach 3 px at
-#: sigma 0.7, ceil(4 sigma) beyond; OpenCV gives a region's pixels this far inside it the
-#: whole frame's values bit for bit, measured at 8 px) and the alignment of its left column
+#: a region's blurred pixels equal the whole frame's (bit for bit) this far inside it beyond
+#: the Gaussian's reach (OpenCV's taps reach ceil(4 sigma) px, 3 at sigma 0.7; measured: 8 px
+#: suffice there, 4-6 do not, the filter's border rows take another path) when the region's
+#: left column is aligned to ALIGN_PX (the rows' SIMD blocks then match the frame's)
 BLUR_MARGIN_PX, ALIGN_PX = 8, 64
 #: how many (camera, light, blur) surrounds are kept (20 MB each at 5 MP)
 CACHE_SURROUNDS = 4
@@ -174,7 +176,7 @@ def _surround(stereo: StereoCalibration, side: str, blur: float) -> np.ndarray:
 def _region(box, blur: float, w: int, h: int) -> tuple[tuple[int, int, int, int], tuple]:
     """The pixels to render around ``box`` (x0, y0, x1, y1) and, inside them, the ones whose
     blurred values are the whole frame's (as (x0, y0, x1, y1) of the frame)."""
-    m = BLUR_MARGIN_PX if blur > 0 else 0
+    m = BLUR_MARGIN_PX + math.ceil(4.0 * blur) if blur > 0 else 0
     x0, y0 = max(box[0] - 2 * m, 0) // ALIGN_PX * ALIGN_PX, max(box[1] - 2 * m, 0)
     x1, y1 = min(box[2] + 2 * m, w), min(box[3] + 2 * m, h)
     inner = (x0 + m if x0 > 0 else 0, y0 + m if y0 > 0 else 0,
