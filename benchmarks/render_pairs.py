@@ -116,8 +116,8 @@ def child(n: int) -> None:
 
 def _run(code_dir: Path | None, n: int) -> dict:
     env = dict(os.environ)
-    paths = [str(ROOT)] + ([str(code_dir)] if code_dir else [])
-    env["PYTHONPATH"] = os.pathsep.join(paths[::-1] + [env.get("PYTHONPATH", "")])
+    paths = [str(code_dir)] if code_dir else []  # the baseline's measure/ wins over ours
+    env["PYTHONPATH"] = os.pathsep.join([*paths, str(ROOT), env.get("PYTHONPATH", "")])
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", "--pairs", str(n)]
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True, cwd=ROOT)
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -151,9 +151,10 @@ def main() -> None:
     for kind in KINDS:
         b = np.median(np.concatenate([r[kind]["cpu_ms"] for r in runs["before"]]))
         a = np.median(np.concatenate([r[kind]["cpu_ms"] for r in runs["after"]]))
-        same = sum(x == y for x, y in zip(runs["before"][0][kind]["digests"],
-                                          runs["after"][0][kind]["digests"], strict=True))  # fmt: skip
-        print(f"| {kind:<11} | {b:9.1f} | {a:8.1f} | {b / a:7.1f}x | {same:>7d} of {args.pairs:<5d} |")
+        old, new = runs["before"][0][kind]["digests"], runs["after"][0][kind]["digests"]
+        same = sum(x == y for x, y in zip(old, new, strict=True))
+        n = args.pairs
+        print(f"| {kind:<11} | {b:9.1f} | {a:8.1f} | {b / a:7.1f}x | {same:>7d} of {n:<5d} |")
 
 
 if __name__ == "__main__":

@@ -8,9 +8,9 @@ the optics blur); the camera's noise and quantisation are those of
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 import threading
 from collections import OrderedDict
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import cv2

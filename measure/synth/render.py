@@ -17,11 +17,12 @@ import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
+from measure.synth.hole_background import background as _background
 from measure.synth.hole_scene import HoleGeometry, Shading, shade
 from measure.synth.marker_draw import MarkerPatch, draw_markers
-from measure.synth.optics import frame_ray_grid, ray_grid, vignetting
+from measure.synth.optics import ray_grid, vignetting
 from measure.synth.sensor import finish_region
-from measure.synth.texture import TEXEL_M, TILE_CENTER_M, background_noise_at, sample_texture
+from measure.synth.texture import TILE_CENTER_M, background_noise_at
 
 
 @dataclass(frozen=True)
@@ -120,37 +121,6 @@ def _in_plane_axes(normal: np.ndarray, angle: float) -> tuple[np.ndarray, np.nda
     b = np.cross(normal, a)
     e1 = math.cos(angle) * a + math.sin(angle) * b
     return e1, np.cross(normal, e1)
-
-
-def _background(
-    stereo: StereoCalibration, side: str, geo: HoleGeometry, sh: Shading, vig: float
-) -> np.ndarray:
-    """Textured, vignetted surface without the hole (fraction of full scale, float32).
-
-    Computed at half resolution (pixel ``i`` of the half image is full pixel ``2i + 0.5``)
-    and upsampled: the background only has to look right, the hole window is exact.
-    """
-    w, h = stereo.image_size
-    step = 16.0
-    grid = frame_ray_grid(stereo, side, step)
-    x, y = geo.plane_hit(grid.nx, grid.ny)
-    K = stereo.K_left if side == "left" else stereo.K_right
-    gy, gx = np.mgrid[0 : grid.nx.shape[0], 0 : grid.nx.shape[1]]
-    V = vignetting(grid.x0 + step * gx, grid.y0 + step * gy, K, stereo.image_size, vig)
-    hw, hh = (w + 1) // 2, (h + 1) // 2
-    M = np.array(
-        [[2.0 / step, 0.0, (0.5 - grid.x0) / step], [0.0, 2.0 / step, (0.5 - grid.y0) / step]]
-    )
-    flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
-    maps = [
-        cv2.warpAffine(
-            a.astype(np.float32), M, (hw, hh), flags=flags, borderMode=cv2.BORDER_REPLICATE
-        )
-        for a in ((x + sh.texture_offset[0]) / TEXEL_M, (y + sh.texture_offset[1]) / TEXEL_M, V)
-    ]
-    tex = sample_texture(maps[0], maps[1])
-    half = (sh.surface * maps[2]) * (1.0 + sh.texture_amplitude * tex)
-    return cv2.resize(half, (w, h), interpolation=cv2.INTER_LINEAR)
 
 
 def _window(

@@ -191,8 +191,11 @@ def _block_value(nx, ny, bx0, by0, bx1, by1, H, kind, cols, rows, ulo, uhi, vlo,
         return -1.0
     du, dv = (0.75 + BLOCK_SLACK_PX) * gu_hi, (0.75 + BLOCK_SLACK_PX) * gv_hi
     u0, u1, v0, v1 = umin - du, umax + du, vmin - dv, vmax + dv
-    if _crosses(u0, u1, ulo) or _crosses(u0, u1, uhi) or _crosses(v0, v1, vlo) or _crosses(
-        v0, v1, vhi
+    if (
+        _crosses(u0, u1, ulo)
+        or _crosses(u0, u1, uhi)
+        or _crosses(v0, v1, vlo)
+        or _crosses(v0, v1, vhi)
     ):
         return -1.0
     if not (ulo < u0 and u1 < uhi and vlo < v0 and v1 < vhi):

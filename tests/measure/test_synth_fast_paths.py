@@ -72,7 +72,9 @@ def test_plate_pair_is_the_whole_frame_render(shift, blur, noise):
     assert (new.left != new.left[0, 0]).mean() > 0.2  # the plate is in view
 
 
-@pytest.mark.parametrize("spec", [BOARD, TargetSpec("circles", 4, 7, 0.006)], ids=["board", "circles"])
+@pytest.mark.parametrize(
+    "spec", [BOARD, TargetSpec("circles", 4, 7, 0.006)], ids=["board", "circles"]
+)
 def test_plate_blocks_are_the_per_pixel_values(spec):
     st = toed_in_stereo(image_size=(320, 256))
     T = _pose(tilt=(0.5, 0.3, 0.2), z=0.45)
