@@ -136,11 +136,15 @@ def main() -> None:
     load0 = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp:
         archive = subprocess.run(["git", "archive", args.baseline, "measure"], cwd=ROOT,
-                                 capture_output=True, check=True).stdout  # fmt: skip
-        subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+                                 capture_output=True)  # fmt: skip
         runs: dict[str, list[dict]] = {"before": [], "after": []}
+        if archive.returncode == 0:
+            subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
+        else:  # e.g. a shallow clone: the current renderer alone
+            print(f"(no baseline: git archive {args.baseline} failed; 'before' = this tree)")
+            tmp = None
         for _ in range(args.rounds):
-            runs["before"].append(_run(Path(tmp), args.pairs))
+            runs["before"].append(_run(Path(tmp) if tmp else None, args.pairs))
             runs["after"].append(_run(None, args.pairs))
     load1 = os.getloadavg()[0]
     print(f"CPU per 5 MP stereo pair (ms; median over {args.pairs} pairs x {args.rounds} "
