@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import cv2
 import numpy as np
@@ -82,9 +83,9 @@ def marker_axes(normal: np.ndarray, up: np.ndarray | None) -> np.ndarray:
     return np.column_stack([x, _cross(n, x), n])
 
 
-def _outline(m: MarkerPatch, R: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Points (k, 3) around the printed marker (camera frame)."""
-    d = m.design
+@lru_cache(maxsize=16)
+def _outline_uv(d: MarkerDesign) -> np.ndarray:
+    """Points (k, 2) around a design's printed label (dot diameters; read-only, cached)."""
     if d.kind == "ring":
         phi = np.linspace(0.0, 2 * np.pi, 48, endpoint=False)
         uv = d.label_radius * np.stack([np.cos(phi), np.sin(phi)], axis=1)
@@ -100,7 +101,13 @@ def _outline(m: MarkerPatch, R: np.ndarray, c: np.ndarray) -> np.ndarray:
                 np.stack([np.full_like(s, x_hi), ys], 1),
             ]
         )
-    return c + m.diameter_m * (uv @ R[:, :2].T)
+    uv.setflags(write=False)
+    return uv
+
+
+def _outline(m: MarkerPatch, R: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Points (k, 3) around the printed marker (camera frame)."""
+    return c + m.diameter_m * (_outline_uv(m.design) @ R[:, :2].T)
 
 
 def _geometry(d: MarkerDesign, code: int) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
