@@ -16,12 +16,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
-from measure.markers.bias import _plane_axes
 from measure.markers.codes import apriltag_cells, ring_bits
 from measure.markers.design import DEFAULT_DESIGN, MarkerDesign
 from measure.synth.marker_pattern import APRILTAG, RING, marker_patch
@@ -57,24 +57,35 @@ class MarkerPatch:
             raise ValueError(f"marker diameter_m must be positive, got {self.diameter_m}")
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross`` of two 3-vectors: the same arithmetic, without its overhead (a survey view
+    asks for hundreds)."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def marker_axes(normal: np.ndarray, up: np.ndarray | None) -> np.ndarray:
-    """Columns ``(x, y, n)``: ``x`` along ``up`` (projected into the plane), ``y = n × x``."""
+    """Columns ``(x, y, n)``: ``x`` along ``up`` (projected into the plane), ``y = n × x``;
+    without ``up``, ``x`` is :func:`measure.markers.bias._plane_axes`' first axis."""
     n = np.asarray(normal, dtype=float).reshape(3)
     n = n / np.linalg.norm(n)
     if up is None:
-        x = _plane_axes(n)[0]
+        ref = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        x = _cross(n, ref)
+        x /= np.linalg.norm(x)
     else:
         x = np.asarray(up, dtype=float).reshape(3)
         x = x - (x @ n) * n
         if np.linalg.norm(x) < 1e-9:
             raise ValueError("marker up must not be parallel to its normal")
         x = x / np.linalg.norm(x)
-    return np.column_stack([x, np.cross(n, x), n])
+    return np.column_stack([x, _cross(n, x), n])
 
 
-def _outline(m: MarkerPatch, R: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Points (k, 3) around the printed marker (camera frame)."""
-    d = m.design
+@lru_cache(maxsize=16)
+def _outline_uv(d: MarkerDesign) -> np.ndarray:
+    """Points (k, 2) around a design's printed label (dot diameters; read-only, cached)."""
     if d.kind == "ring":
         phi = np.linspace(0.0, 2 * np.pi, 48, endpoint=False)
         uv = d.label_radius * np.stack([np.cos(phi), np.sin(phi)], axis=1)
@@ -90,7 +101,13 @@ def _outline(m: MarkerPatch, R: np.ndarray, c: np.ndarray) -> np.ndarray:
                 np.stack([np.full_like(s, x_hi), ys], 1),
             ]
         )
-    return c + m.diameter_m * (uv @ R[:, :2].T)
+    uv.setflags(write=False)
+    return uv
+
+
+def _outline(m: MarkerPatch, R: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Points (k, 3) around the printed marker (camera frame)."""
+    return c + m.diameter_m * (_outline_uv(m.design) @ R[:, :2].T)
 
 
 def _geometry(d: MarkerDesign, code: int) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:

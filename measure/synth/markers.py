@@ -8,6 +8,8 @@ the optics blur); the camera's noise and quantisation are those of
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -16,7 +18,8 @@ import numpy as np
 
 from measure.calibration import StereoCalibration
 from measure.synth.marker_draw import MarkerPatch, draw_markers
-from measure.synth.optics import ray_grid, vignetting
+from measure.synth.optics import vignetting
+from measure.synth.pixel_rays import pixel_rays_key
 from measure.synth.render import RenderOptions, _camera_output
 
 __all__ = ["MarkerPatch", "MarkerRender", "render_markers_pair"]
@@ -34,19 +37,40 @@ class MarkerRender:
     markers: tuple[MarkerPatch, ...]
 
 
+#: how many survey backgrounds (camera, surface level, vignetting) are kept (20 MB each at 5 MP)
+CACHE_BACKGROUNDS = 4
+_backgrounds: OrderedDict[tuple, np.ndarray] = OrderedDict()
+_lock = threading.Lock()
+
+
 def _background(stereo: StereoCalibration, side: str, opts: RenderOptions) -> np.ndarray:
-    """A dim, vignetted background (fraction of full scale, float32), at 16-px nodes."""
+    """A dim, vignetted background (fraction of full scale, float32, read-only), at 16-px nodes
+    (those of :func:`measure.synth.optics.ray_grid` over the image); cached per camera and
+    levels: every survey view of a camera has the same."""
+    key = (pixel_rays_key(stereo, side), float(opts.surface), float(opts.vignetting))
+    with _lock:
+        hit = _backgrounds.get(key)
+        if hit is not None:
+            _backgrounds.move_to_end(key)
+            return hit
     w, h = stereo.image_size
-    grid = ray_grid(stereo, side, 0.0, 0.0, w, h, 16.0)  # only its node positions are used
-    rows, cols = grid.nx.shape
-    gx = grid.x0 + 16.0 * np.arange(cols)
-    gy = grid.y0 + 16.0 * np.arange(rows)
+    step = 16.0
+    cols, rows = int(np.ceil(w / step)) + 3, int(np.ceil(h / step)) + 3
+    x0, y0 = float(0.0 - step), float(0.0 - step)  # the grid's first node
+    gx = x0 + 16.0 * np.arange(cols)
+    gy = y0 + 16.0 * np.arange(rows)
     K = stereo.K_left if side == "left" else stereo.K_right
     V = vignetting(gx[None, :], gy[:, None], K, stereo.image_size, opts.vignetting)
     small = (BACKGROUND * opts.surface / 0.62 * V).astype(np.float32)
-    M = np.array([[1 / 16.0, 0.0, -grid.x0 / 16.0], [0.0, 1 / 16.0, -grid.y0 / 16.0]])
+    M = np.array([[1 / 16.0, 0.0, -x0 / 16.0], [0.0, 1 / 16.0, -y0 / 16.0]])
     flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
-    return cv2.warpAffine(small, M, (w, h), flags=flags, borderMode=cv2.BORDER_REPLICATE)
+    img = cv2.warpAffine(small, M, (w, h), flags=flags, borderMode=cv2.BORDER_REPLICATE)
+    img.setflags(write=False)
+    with _lock:
+        _backgrounds[key] = img
+        while len(_backgrounds) > CACHE_BACKGROUNDS:
+            _backgrounds.popitem(last=False)
+    return img
 
 
 def render_markers_pair(
@@ -63,7 +87,7 @@ def render_markers_pair(
     rng = np.random.default_rng(seed)
     out = []
     for side in ("left", "right"):
-        img = _background(stereo, side, opts)
+        img = _background(stereo, side, opts).copy()
         draw_markers(img, stereo, side, markers, opts.blur_sigma_px, opts.vignetting)
         out.append(_camera_output(img, opts, (0, 0, 0, 0), rng))
     return MarkerRender(left=out[0], right=out[1], markers=tuple(markers))

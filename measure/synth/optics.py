@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import math
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from measure.calibration import StereoCalibration
+from measure.synth.pixel_rays import pixel_rays_key
 
 
 @dataclass(frozen=True)
@@ -24,19 +29,34 @@ class RayGrid:
     ny: np.ndarray  # (rows, cols) normalised y
 
     def sample(self, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Normalised coordinates at pixel coordinates ``px``, ``py`` (float64 bilinear)."""
-        fx = (np.asarray(px, dtype=np.float64) - self.x0) / self.step
-        fy = (np.asarray(py, dtype=np.float64) - self.y0) / self.step
-        rows, cols = self.nx.shape
-        ix = np.clip(np.floor(fx).astype(np.int64), 0, cols - 2)
-        iy = np.clip(np.floor(fy).astype(np.int64), 0, rows - 2)
+        """Normalised coordinates at pixel coordinates ``px``, ``py`` (float64 bilinear; one
+        compiled pass, the arithmetic of NumPy's version: the same values)."""
+        px = np.ascontiguousarray(px, dtype=np.float64)
+        py = np.ascontiguousarray(py, dtype=np.float64)
+        ox, oy = np.empty(px.shape), np.empty(px.shape)
+        _bilinear(self.nx, self.ny, float(self.x0), float(self.y0), float(self.step),
+                  px.reshape(-1), py.reshape(-1), ox.reshape(-1), oy.reshape(-1))  # fmt: skip
+        return ox, oy
+
+
+@njit(cache=True)
+def _bilinear(gnx, gny, x0, y0, step, px, py, ox, oy) -> None:
+    """``ox[k], oy[k]``: the grids ``gnx``, ``gny`` (nodes at ``x0 + i step``, ``y0 + j step``)
+    interpolated bilinearly at ``(px[k], py[k])``, clamped to the outer cells."""
+    rows, cols = gnx.shape
+    for k in range(px.shape[0]):
+        fx = (px[k] - x0) / step
+        fy = (py[k] - y0) / step
+        ix = min(max(np.int64(math.floor(fx)), 0), cols - 2)
+        iy = min(max(np.int64(math.floor(fy)), 0), rows - 2)
         ax, ay = fx - ix, fy - iy
-        out = []
-        for grid in (self.nx, self.ny):
-            g00, g01 = grid[iy, ix], grid[iy, ix + 1]
-            g10, g11 = grid[iy + 1, ix], grid[iy + 1, ix + 1]
-            out.append((g00 * (1 - ax) + g01 * ax) * (1 - ay) + (g10 * (1 - ax) + g11 * ax) * ay)
-        return out[0], out[1]
+        bx, by = 1 - ax, 1 - ay
+        ox[k] = (gnx[iy, ix] * bx + gnx[iy, ix + 1] * ax) * by + (
+            gnx[iy + 1, ix] * bx + gnx[iy + 1, ix + 1] * ax
+        ) * ay
+        oy[k] = (gny[iy, ix] * bx + gny[iy, ix + 1] * ax) * by + (
+            gny[iy + 1, ix] * bx + gny[iy + 1, ix + 1] * ax
+        ) * ay
 
 
 def ray_grid(
@@ -56,6 +76,32 @@ def ray_grid(
         nx=norm[:, 0].reshape(rows, cols),
         ny=norm[:, 1].reshape(rows, cols),
     )
+
+
+#: how many cameras' full-frame ray grids :func:`frame_ray_grid` keeps
+CACHE_GRIDS = 8
+_grids: OrderedDict[tuple, RayGrid] = OrderedDict()
+_lock = threading.Lock()
+
+
+def frame_ray_grid(stereo: StereoCalibration, side: str, step: float) -> RayGrid:
+    """``ray_grid(stereo, side, 0, 0, w, h, step)`` over the whole image, cached per camera
+    model (read-only arrays): every render of a camera asks for the same one."""
+    w, h = stereo.image_size
+    key = (pixel_rays_key(stereo, side), float(step))
+    with _lock:
+        hit = _grids.get(key)
+        if hit is not None:
+            _grids.move_to_end(key)
+            return hit
+    grid = ray_grid(stereo, side, 0.0, 0.0, w, h, step)
+    grid.nx.setflags(write=False)
+    grid.ny.setflags(write=False)
+    with _lock:
+        _grids[key] = grid
+        while len(_grids) > CACHE_GRIDS:
+            _grids.popitem(last=False)
+    return grid
 
 
 def vignetting(

@@ -17,10 +17,12 @@ import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
+from measure.synth.hole_background import background as _background
 from measure.synth.hole_scene import HoleGeometry, Shading, shade
 from measure.synth.marker_draw import MarkerPatch, draw_markers
 from measure.synth.optics import ray_grid, vignetting
-from measure.synth.texture import TEXEL_M, TILE_CENTER_M, background_noise, sample_texture
+from measure.synth.sensor import finish_region
+from measure.synth.texture import TILE_CENTER_M, background_noise_at
 
 
 @dataclass(frozen=True)
@@ -121,37 +123,6 @@ def _in_plane_axes(normal: np.ndarray, angle: float) -> tuple[np.ndarray, np.nda
     return e1, np.cross(normal, e1)
 
 
-def _background(
-    stereo: StereoCalibration, side: str, geo: HoleGeometry, sh: Shading, vig: float
-) -> np.ndarray:
-    """Textured, vignetted surface without the hole (fraction of full scale, float32).
-
-    Computed at half resolution (pixel ``i`` of the half image is full pixel ``2i + 0.5``)
-    and upsampled: the background only has to look right, the hole window is exact.
-    """
-    w, h = stereo.image_size
-    step = 16.0
-    grid = ray_grid(stereo, side, 0.0, 0.0, w, h, step)
-    x, y = geo.plane_hit(grid.nx, grid.ny)
-    K = stereo.K_left if side == "left" else stereo.K_right
-    gy, gx = np.mgrid[0 : grid.nx.shape[0], 0 : grid.nx.shape[1]]
-    V = vignetting(grid.x0 + step * gx, grid.y0 + step * gy, K, stereo.image_size, vig)
-    hw, hh = (w + 1) // 2, (h + 1) // 2
-    M = np.array(
-        [[2.0 / step, 0.0, (0.5 - grid.x0) / step], [0.0, 2.0 / step, (0.5 - grid.y0) / step]]
-    )
-    flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
-    maps = [
-        cv2.warpAffine(
-            a.astype(np.float32), M, (hw, hh), flags=flags, borderMode=cv2.BORDER_REPLICATE
-        )
-        for a in ((x + sh.texture_offset[0]) / TEXEL_M, (y + sh.texture_offset[1]) / TEXEL_M, V)
-    ]
-    tex = sample_texture(maps[0], maps[1])
-    half = (sh.surface * maps[2]) * (1.0 + sh.texture_amplitude * tex)
-    return cv2.resize(half, (w, h), interpolation=cv2.INTER_LINEAR)
-
-
 def _window(
     stereo: StereoCalibration, side: str, geo: HoleGeometry, r_win: float
 ) -> tuple[int, int, int, int]:
@@ -215,25 +186,30 @@ def _render_window(
 
 
 def _finish(img: np.ndarray, opts: RenderOptions, win, rng: np.random.Generator) -> np.ndarray:
-    """Scale to gray levels, add shot and read noise (fresh in the window), quantise."""
+    """Scale to gray levels, add shot and read noise (fresh in the window), quantise. Read
+    noise alone (the default) takes one compiled pass (:func:`finish_region`); ``img`` may be
+    overwritten."""
     full = 255.0 if opts.bit_depth == 8 else 4095.0
-    dn = img
-    dn *= np.float32(full)
-    bank = background_noise(dn.shape, rng)
+    bank, by0, bx0, flipped = background_noise_at(img.shape, rng)
     x0, y0, w, h = win
     fresh = rng.standard_normal((h, w), dtype=np.float32) if w > 0 and h > 0 else None
-    if opts.full_well_e:
-        gain = np.float32(full / opts.full_well_e)
-        sigma = np.sqrt(np.float32(opts.read_noise_dn**2) + np.maximum(dn, 0) * gain)
-        noise = sigma * bank
-        if fresh is not None:
-            noise[y0 : y0 + h, x0 : x0 + w] = sigma[y0 : y0 + h, x0 : x0 + w] * fresh
-        dn += noise
-    elif opts.read_noise_dn > 0:
-        read = np.float32(opts.read_noise_dn)
-        dn += read * bank
-        if fresh is not None:  # the measured region gets noise of its own
-            dn[y0 : y0 + h, x0 : x0 + w] += read * (fresh - bank[y0 : y0 + h, x0 : x0 + w])
+    if not opts.full_well_e:
+        read = np.float32(opts.read_noise_dn if opts.read_noise_dn > 0 else 0.0)
+        out = np.empty(img.shape, dtype=np.uint8 if opts.bit_depth == 8 else np.uint16)
+        fr = fresh if fresh is not None else np.zeros((0, 0), dtype=np.float32)
+        finish_region(np.ascontiguousarray(img), np.float32(full), read, bank, by0, bx0,
+                      flipped, fr, x0, y0, int(full), out)  # fmt: skip
+        return out
+    bank = bank[by0 : by0 + img.shape[0], bx0 : bx0 + img.shape[1]]
+    bank = bank[::-1] if flipped else bank
+    dn = img
+    dn *= np.float32(full)
+    gain = np.float32(full / opts.full_well_e)
+    sigma = np.sqrt(np.float32(opts.read_noise_dn**2) + np.maximum(dn, 0) * gain)
+    noise = sigma * bank
+    if fresh is not None:
+        noise[y0 : y0 + h, x0 : x0 + w] = sigma[y0 : y0 + h, x0 : x0 + w] * fresh
+    dn += noise
     np.maximum(dn, 0.0, out=dn)
     if opts.bit_depth == 8:
         return cv2.convertScaleAbs(dn)  # rounds and saturates at 255

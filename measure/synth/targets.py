@@ -11,14 +11,18 @@ point-sampling renderer as the reference.
 
 from __future__ import annotations
 
+import math
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
-from measure.synth.pixel_rays import pixel_rays
-from measure.synth.target_pattern import CHESSBOARD, CIRCLES, plate_image
+from measure.synth.pixel_rays import pixel_rays, pixel_rays_key
+from measure.synth.sensor import quantize_u8
+from measure.synth.target_pattern import CHESSBOARD, CIRCLES, plate_image, plate_region
 from measure.target import TargetSpec
 
 #: relative illumination lost at the image corner
@@ -85,6 +89,34 @@ def plate_homography(R: np.ndarray, t: np.ndarray, pitch_m: float) -> np.ndarray
     )
 
 
+def _light(stereo: StereoCalibration, side: str, vignetting: float, gain: float) -> np.ndarray:
+    """:func:`plate_region`'s ``light``: (gain, strength, cx, cy, r_corner²)."""
+    w, h = stereo.image_size
+    K = _camera(stereo, side)[0]
+    cx, cy = float(K[0, 2]), float(K[1, 2])
+    rc2 = max(cx, w - 1 - cx) ** 2 + max(cy, h - 1 - cy) ** 2
+    return np.array([gain, vignetting, cx, cy, rc2])
+
+
+def _plate_args(stereo, side, R, t, spec, vignetting, gain, blur=None):
+    """The arguments of :func:`plate_region` but the region and the output; the rays are
+    valid over the whole image, or (``blur`` given) over the rows :func:`_region` asks for."""
+    light = _light(stereo, side, vignetting, gain)
+    box = plate_box(stereo, side, R, t, spec) or (0, 0, 0, 0)
+    rows = None
+    if blur is not None:
+        w, h = stereo.image_size
+        (_, y0, _, y1), _ = _region(box, blur, w, h)
+        rows = (y0 - 1, y1 + 1) if box[2] > box[0] and box[3] > box[1] else (0, 0)
+    nx, ny = pixel_rays(stereo, side, rows)
+    lo, hi = spec.plate_bounds()
+    bounds = np.array([lo[0], hi[0], lo[1], hi[1]]) / spec.pitch_m
+    kind = CHESSBOARD if spec.kind == "chessboard" else CIRCLES
+    H = plate_homography(R, t, spec.pitch_m)
+    return (nx, ny, np.array(box, dtype=np.int64), H, kind, float(spec.cols), float(spec.rows),
+            0.5 * spec.circle_diameter_frac, bounds, light)  # fmt: skip
+
+
 def render_plate(
     stereo: StereoCalibration,
     side: str,
@@ -98,45 +130,85 @@ def render_plate(
     optics blur: area-integrated reflectance times ``gain (1 - vignetting (r / r_corner)²)``
     ((h, w) float32)."""
     w, h = stereo.image_size
-    K = _camera(stereo, side)[0]
-    cx, cy = float(K[0, 2]), float(K[1, 2])
-    rc2 = max(cx, w - 1 - cx) ** 2 + max(cy, h - 1 - cy) ** 2
-    light = np.array([gain, vignetting, cx, cy, rc2])
-    box = plate_box(stereo, side, R, t, spec) or (0, 0, 0, 0)
-    nx, ny = pixel_rays(stereo, side)
-    lo, hi = spec.plate_bounds()
-    bounds = np.array([lo[0], hi[0], lo[1], hi[1]]) / spec.pitch_m
-    kind = CHESSBOARD if spec.kind == "chessboard" else CIRCLES
-    H = plate_homography(R, t, spec.pitch_m)
     out = np.empty((h, w), dtype=np.float32)
-    plate_image(
-        nx,
-        ny,
-        np.array(box, dtype=np.int64),
-        H,
-        kind,
-        float(spec.cols),
-        float(spec.rows),
-        0.5 * spec.circle_diameter_frac,
-        bounds,
-        light,
-        out,
-    )
+    plate_image(*_plate_args(stereo, side, R, t, spec, vignetting, gain), out)
     return out
 
 
-def _render_side(stereo, side, R, t, spec, blur, noise, rng) -> np.ndarray:
-    img = render_plate(stereo, side, R, t, spec, VIGNETTING, 255.0)
+#: a region's blurred pixels equal the whole frame's (bit for bit) this far inside it beyond
+#: the Gaussian's reach (OpenCV's taps reach ceil(4 sigma) px, 3 at sigma 0.7; measured: 8 px
+#: suffice there, 4-6 do not, the filter's border rows take another path) when the region's
+#: left column is aligned to ALIGN_PX (the rows' SIMD blocks then match the frame's)
+BLUR_MARGIN_PX, ALIGN_PX = 8, 64
+#: how many (camera, light, blur) surrounds are kept (20 MB each at 5 MP)
+CACHE_SURROUNDS = 4
+
+_surrounds: OrderedDict[tuple, np.ndarray] = OrderedDict()
+_lock = threading.Lock()
+
+
+def _surround(stereo: StereoCalibration, side: str, blur: float) -> np.ndarray:
+    """The frame with no plate in view, lit and blurred ((h, w) float32, read-only; cached):
+    what every pixel far from the plate shows."""
+    key = (pixel_rays_key(stereo, side), VIGNETTING, 255.0, float(blur))
+    with _lock:
+        hit = _surrounds.get(key)
+        if hit is not None:
+            _surrounds.move_to_end(key)
+            return hit
+    w, h = stereo.image_size
+    nx = np.zeros((1, 1), dtype=np.float32)  # no plate pixel: only the light matters, no ray
+    nx.setflags(write=False)
+    none = np.zeros(4, dtype=np.int64)
+    img = np.empty((h, w), dtype=np.float32)
+    plate_image(nx, nx, none, np.eye(3), CHESSBOARD, 1.0, 1.0, 0.5, np.zeros(4),
+                _light(stereo, side, VIGNETTING, 255.0), img)  # fmt: skip
     if blur > 0:
         img = cv2.GaussianBlur(img, (0, 0), blur)
+    img.setflags(write=False)
+    with _lock:
+        _surrounds[key] = img
+        while len(_surrounds) > CACHE_SURROUNDS:
+            _surrounds.popitem(last=False)
+    return img
+
+
+def _region(box, blur: float, w: int, h: int) -> tuple[tuple[int, int, int, int], tuple]:
+    """The pixels to render around ``box`` (x0, y0, x1, y1) and, inside them, the ones whose
+    blurred values are the whole frame's (as (x0, y0, x1, y1) of the frame)."""
+    m = BLUR_MARGIN_PX + math.ceil(4.0 * blur) if blur > 0 else 0
+    x0, y0 = max(box[0] - 2 * m, 0) // ALIGN_PX * ALIGN_PX, max(box[1] - 2 * m, 0)
+    x1, y1 = min(box[2] + 2 * m, w), min(box[3] + 2 * m, h)
+    inner = (x0 + m if x0 > 0 else 0, y0 + m if y0 > 0 else 0,
+             x1 - m if x1 < w else w, y1 - m if y1 < h else h)  # fmt: skip
+    return (x0, y0, x1, y1), inner
+
+
+def _render_side(stereo, side, R, t, spec, blur, noise, rng) -> np.ndarray:
+    """One camera's image: the plate drawn and blurred over its box only (the rest of the frame
+    is the cached blurred surround: the same pixels as blurring the whole frame), read noise
+    over the whole frame (OpenCV's generator, 5x numpy's speed at 5 MP, seeded per image from
+    ``rng``), quantised to 8 bits."""
+    w, h = stereo.image_size
+    args = _plate_args(stereo, side, R, t, spec, VIGNETTING, 255.0, blur)
+    base = _surround(stereo, side, blur)
+    dn = np.empty((0, 0), dtype=np.float32)
     if noise > 0:
-        # OpenCV's generator (5x numpy's speed at 5 MP), seeded per image from ``rng``
         cv2.setRNGSeed(int(rng.integers(0, 2**31 - 1)))
-        dn = np.empty_like(img)
+        dn = np.empty((h, w), dtype=np.float32)
         cv2.randn(dn, 0.0, float(noise))
-        img += dn
-    np.maximum(img, 0.0, out=img)
-    return cv2.convertScaleAbs(img)  # rounds and saturates at 255
+    out = np.empty((h, w), dtype=np.uint8)
+    quantize_u8(base, dn, 0, 0, out)
+    box = args[2]
+    if box[2] > box[0] and box[3] > box[1]:
+        (x0, y0, x1, y1), (ix0, iy0, ix1, iy1) = _region(box, blur, w, h)
+        img = np.empty((y1 - y0, x1 - x0), dtype=np.float32)
+        plate_region(*args[:2], np.array([x0, y0, x1, y1], dtype=np.int64), *args[2:], img)
+        if blur > 0:
+            img = cv2.GaussianBlur(img, (0, 0), blur)
+        inner = np.ascontiguousarray(img[iy0 - y0 : iy1 - y0, ix0 - x0 : ix1 - x0])
+        quantize_u8(inner, dn, ix0, iy0, out)
+    return out
 
 
 def render_target_pair(

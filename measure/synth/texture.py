@@ -68,6 +68,21 @@ def _noise_bank() -> np.ndarray:
     return rng.standard_normal((2048 + 512, 2448 + 512), dtype=np.float32)
 
 
+def background_noise_at(
+    shape: tuple[int, int], rng: np.random.Generator
+) -> tuple[np.ndarray, int, int, bool]:
+    """Where :func:`background_noise` takes its view: ``(bank, y0, x0, flipped)``, the view being
+    ``bank[y0 : y0 + h, x0 : x0 + w]``, its rows reversed when ``flipped`` (the same draws
+    from ``rng``)."""
+    h, w = shape
+    bank = _noise_bank()
+    if h + 1 > bank.shape[0] or w + 1 > bank.shape[1]:
+        return rng.standard_normal(shape, dtype=np.float32), 0, 0, False
+    y0 = int(rng.integers(0, bank.shape[0] - h + 1))
+    x0 = int(rng.integers(0, bank.shape[1] - w + 1))
+    return bank, y0, x0, bool(rng.random() < 0.5)
+
+
 def background_noise(shape: tuple[int, int], rng: np.random.Generator) -> np.ndarray:
     """Unit Gaussian noise of ``shape`` for the background (a random view of a cached bank).
 
@@ -75,10 +90,6 @@ def background_noise(shape: tuple[int, int], rng: np.random.Generator) -> np.nda
     makes the full frame noisy without the cost of drawing 5 million normals per image.
     """
     h, w = shape
-    bank = _noise_bank()
-    if h + 1 > bank.shape[0] or w + 1 > bank.shape[1]:
-        return rng.standard_normal(shape, dtype=np.float32)
-    y0 = int(rng.integers(0, bank.shape[0] - h + 1))
-    x0 = int(rng.integers(0, bank.shape[1] - w + 1))
+    bank, y0, x0, flipped = background_noise_at(shape, rng)
     view = bank[y0 : y0 + h, x0 : x0 + w]
-    return view[::-1] if rng.random() < 0.5 else view
+    return view[::-1] if flipped else view
