@@ -200,7 +200,9 @@ class GtspSequencer:
         table = CostTable(
             limits.velocity, limits.acceleration, limits.jerk, limits.upper - limits.lower
         )
-        self.G = symmetric_costs(table, self.nodes, helper)
+        self.G, held = symmetric_costs(table, self.nodes, helper)
+        #: the matrix the helper holds (planner.shared_costs.held_matrix), while it is ``G``
+        self.helper_G = self.G if held else None
         self.table = table
         self.positions_m = None if positions_m is None else np.asarray(positions_m, float)
         self.task_order: list[int] | None = None  # add_task_space_nodes

@@ -28,6 +28,15 @@ log = logging.getLogger(__name__)
 #: below this many nodes the matrix is built here alone (the hand-over costs ~10 ms)
 SHARED_MIN_NODES = 1024
 
+#: in the helper: the last matrix it filled (still mapped: the same memory as this
+#: process's), for later shares of work on it (:func:`held_matrix`)
+_HELD: dict[str, NDArray[np.float64]] = {}
+
+
+def held_matrix() -> NDArray[np.float64] | None:
+    """In the helper: the matrix its last :func:`fill_rows` filled (None: none)."""
+    return _HELD.get("G")
+
 
 def split_row(n: int) -> int:
     """First row (a multiple of ``SYMMETRIC_BLOCK``) of the second share of an ``n``-node
@@ -70,30 +79,34 @@ def fill_rows(pid: int, fd: int, rows: NDArray[np.float64], table: CostTable, r0
         log.info("the helper cannot open the cost matrix (%s)", exc)
         return False
     out = np.frombuffer(buf, dtype=np.float64).reshape(n, n)
+    _HELD.pop("G", None)
     table.symmetric_rows(rows, out, r0, n)
-    del out
-    buf.close()
+    _HELD["G"] = out  # the mapping lives as long as the array
     return True
 
 
 def symmetric_costs(
     table: CostTable, q: NDArray[np.float64], helper: Helper | None = None
-) -> NDArray[np.float64]:
-    """``table.matrix64(q)``, the same values, half of it made by ``helper`` where given."""
+) -> tuple[NDArray[np.float64], bool]:
+    """``table.matrix64(q)``, the same values, half of it made by ``helper`` where given;
+    and whether the helper holds it (:func:`held_matrix`: it sees this process's later
+    writes to it, the same memory)."""
     rows = np.atleast_2d(np.asarray(q, dtype=float))
     n = rows.shape[0]
     if helper is None or n < SHARED_MIN_NODES:
-        return table.matrix64(rows)
+        return table.matrix64(rows), False
     made = _shared_matrix(n)
     if made is None:
-        return table.matrix64(rows)
+        return table.matrix64(rows), False
     fd, out = made
+    held = False
     try:
         r0 = split_row(n)
         theirs = helper.submit(fill_rows, os.getpid(), fd, rows, table, r0)
         table.symmetric_rows(rows, out, 0, r0)
-        if not Helper.result(theirs, lambda: False):
+        held = bool(Helper.result(theirs, lambda: False))
+        if not held:
             table.symmetric_rows(rows, out, r0, n)
     finally:
         os.close(fd)  # the mapping stays while ``out`` lives
-    return out
+    return out, held

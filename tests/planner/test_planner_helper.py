@@ -110,8 +110,8 @@ def test_cost_matrix_built_with_a_helper_equals_one_process(cell) -> None:
     want = table.matrix64(q)
     assert 0 < split_row(n) < n
     with Helper.start(MIN_HOLES, arm=arm) as helper:
-        got = symmetric_costs(table, q, helper)
-    assert got.dtype == np.float64 and np.array_equal(got, want)
+        got, held = symmetric_costs(table, q, helper)
+    assert held and got.dtype == np.float64 and np.array_equal(got, want)
     got[3, 5] = 9.0  # a writable array, as the sequencer learns costs into it
     assert got[3, 5] == 9.0
 
@@ -126,8 +126,9 @@ def test_a_dead_helper_leaves_the_whole_cost_matrix_to_this_process(cell) -> Non
     helper = Helper.start(MIN_HOLES, arm=arm)
     for pid in list(helper.pool._processes):
         os.kill(pid, signal.SIGKILL)
-    got = symmetric_costs(table, q, helper)
+    got, held = symmetric_costs(table, q, helper)
     helper.close()
+    assert not held
     assert np.array_equal(got, table.matrix64(q))
 
 
@@ -140,3 +141,21 @@ def test_split_row_halves_the_upper_triangle() -> None:
         assert r0 % SYMMETRIC_BLOCK == 0
         first = sum((n - i) for i in range(r0))  # upper-triangle entries of rows < r0
         assert abs(first / (n * (n + 1) / 2) - 0.5) < 0.1
+
+
+def test_neighbour_lists_made_half_in_the_helper_equal_one_process(cell) -> None:
+    from planner.roadmap import neighbour_pairs
+    from planner.shared_costs import SHARED_MIN_NODES, symmetric_costs
+
+    n = SHARED_MIN_NODES + 300
+    arm, table, q = _cost_table_and_nodes(cell, n)
+    owner = np.concatenate([[-1], np.arange(n - 1) // 7])  # home, then holes of 7 nodes
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
+        G, held = symmetric_costs(table, q, helper)
+        assert held
+        far = n - 3  # a later write here (a learned cost) is seen by the helper too
+        G[far, 2] = G[2, far] = 0.0
+        got = neighbour_pairs(G, owner, 5, helper)
+    want = neighbour_pairs(G, owner, 5)
+    assert np.array_equal(got, want)
+    assert [2, far] in want.tolist()
