@@ -114,6 +114,11 @@ def test_cost_matrix_built_with_a_helper_equals_one_process(cell) -> None:
     assert held and got.dtype == np.float64 and np.array_equal(got, want)
     got[3, 5] = 9.0  # a writable array, as the sequencer learns costs into it
     assert got[3, 5] == 9.0
+    import pickle
+
+    copy = pickle.loads(pickle.dumps(got))  # a start's own copy (planner.shared.unpack)
+    copy[3, 5] = 1.0
+    assert np.array_equal(copy[:3], got[:3]) and got[3, 5] == 9.0
 
 
 def test_a_dead_helper_leaves_the_whole_cost_matrix_to_this_process(cell) -> None:
