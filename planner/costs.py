@@ -136,8 +136,16 @@ class CostTable:
         return self._symmetric(rows, np.zeros((n, n), dtype=np.float64))
 
     def _symmetric(self, rows: NDArray[np.float64], out: NDArray[_F]) -> NDArray[_F]:
+        return self.symmetric_rows(rows, out, 0, rows.shape[0])
+
+    def symmetric_rows(
+        self, rows: NDArray[np.float64], out: NDArray[_F], r0: int, r1: int
+    ) -> NDArray[_F]:
+        """Fill the entries of ``out`` (the symmetric matrix of ``rows``) whose smaller index
+        is in ``[r0, r1)`` (``r0`` a multiple of ``SYMMETRIC_BLOCK``): two calls on split
+        ranges, in two processes, fill the matrix of one call with the same values."""
         n = rows.shape[0]
-        for i0 in range(0, n, SYMMETRIC_BLOCK):
+        for i0 in range(r0, min(r1, n), SYMMETRIC_BLOCK):
             i1 = min(i0 + SYMMETRIC_BLOCK, n)
             block = self._block(rows[i0:i1], rows[i0:])
             out[i0:i1, i0:] = block

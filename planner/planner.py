@@ -187,7 +187,8 @@ class TourPlanner(LazyEdgeChecks):
             return
         coarse = BatchEdgeChecker(checker.coarser(ROADMAP_COARSENESS))
         helper = getattr(self, "_helper", None)
-        self._roadmap = build_roadmap(seqr.nodes, seqr.G, seqr.owner, coarse, k, helper)
+        held = helper is not None and seqr.helper_G is seqr.G  # its neighbour lists: half there
+        self._roadmap = build_roadmap(seqr.nodes, seqr.G, seqr.owner, coarse, k, helper, held)
         checker.checks += coarse.checks
         blocked = []
         for (u, v), free in self._roadmap.free.items():

@@ -26,6 +26,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from planner.edge_check import BatchEdgeChecker
 from planner.helper import Helper
+from planner.shared_costs import held_matrix
 
 #: estimated duration of a colliding straight motion without a roadmap detour: factor, extra s
 DETOUR_FACTOR = 1.5
@@ -91,19 +92,55 @@ class Roadmap:
 NEIGHBOUR_BLOCK = 256
 
 
-def neighbour_pairs(G: NDArray[np.float64], owner: NDArray[np.int64], k: int) -> np.ndarray:
-    """Undirected pairs (u < v) joining each node to its ``k`` nearest nodes of other holes."""
-    N = G.shape[0]
-    k = min(k, N - 1)
-    near = np.zeros((N, max(k, 0)), dtype=np.int64)
-    nearest = np.zeros((N, max(k, 0)))
-    for r0 in range(0, N if k > 0 else 0, NEIGHBOUR_BLOCK):  # row blocks: cache-friendly
-        r1 = min(r0 + NEIGHBOUR_BLOCK, N)
-        D = np.minimum(G[r0:r1], G[:, r0:r1].T)
-        D[owner[r0:r1, None] == owner[None, :]] = np.inf  # same hole (and home with itself)
+def _near_rows(
+    G: NDArray[np.float64], owner: NDArray[np.int64], k: int, r0: int, r1: int
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Rows ``r0:r1`` of :func:`neighbour_pairs`' lists: the ``k`` nearest nodes of other
+    holes of each node, and their costs (s, inf where fewer)."""
+    near = np.zeros((r1 - r0, k), dtype=np.int64)
+    nearest = np.zeros((r1 - r0, k))
+    for b0 in range(r0, r1, NEIGHBOUR_BLOCK):  # row blocks: cache-friendly
+        b1 = min(b0 + NEIGHBOUR_BLOCK, r1)
+        D = np.minimum(G[b0:b1], G[:, b0:b1].T)
+        D[owner[b0:b1, None] == owner[None, :]] = np.inf  # same hole (and home with itself)
         part = np.argpartition(D, k - 1, axis=1)[:, :k]
-        near[r0:r1] = part
-        nearest[r0:r1] = np.take_along_axis(D, part, axis=1)
+        near[b0 - r0 : b1 - r0] = part
+        nearest[b0 - r0 : b1 - r0] = np.take_along_axis(D, part, axis=1)
+    return near, nearest
+
+
+def near_rows_of_held(
+    owner: NDArray[np.int64], k: int, r0: int
+) -> tuple[NDArray[np.int64], NDArray[np.float64]] | None:
+    """In the helper: :func:`_near_rows` from ``r0`` to the end of its held cost matrix
+    (:func:`planner.shared_costs.held_matrix`; None: it holds none of that size)."""
+    G = held_matrix()
+    if G is None or G.shape[0] != len(owner):
+        return None
+    return _near_rows(G, owner, k, r0, G.shape[0])
+
+
+def neighbour_pairs(
+    G: NDArray[np.float64], owner: NDArray[np.int64], k: int, helper: Helper | None = None
+) -> np.ndarray:
+    """Undirected pairs (u < v) joining each node to its ``k`` nearest nodes of other holes.
+
+    ``helper``: a helper holding ``G`` (:func:`planner.shared_costs.held_matrix`) makes the
+    lists of the second half of the rows (the same lists)."""
+    N = G.shape[0]
+    k = max(min(k, N - 1), 0)
+    if k == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    half = (N // 2) // NEIGHBOUR_BLOCK * NEIGHBOUR_BLOCK if helper is not None else N
+    theirs = helper.submit(near_rows_of_held, owner, k, half) if helper and half else None
+    if theirs is None:
+        half = N
+    mine = _near_rows(G, owner, k, 0, half)
+    if theirs is not None:
+        got = Helper.result(theirs, lambda: None)
+        rest = _near_rows(G, owner, k, half, N) if got is None else got
+        mine = (np.vstack([mine[0], rest[0]]), np.vstack([mine[1], rest[1]]))
+    near, nearest = mine
     u = np.repeat(np.arange(N), near.shape[1])
     v = near.ravel()
     ok = np.isfinite(nearest.ravel())
@@ -118,10 +155,13 @@ def build_roadmap(
     checker: BatchEdgeChecker,
     k: int,
     helper: Helper | None = None,
+    helper_holds_G: bool = False,
 ) -> Roadmap:
     """Check the ``k``-nearest motions of every node in one batch (see module docstring),
-    half of them in the ``helper`` process if given (:mod:`planner.helper`)."""
-    pairs = neighbour_pairs(G, owner, k)
+    half of them in the ``helper`` process if given (:mod:`planner.helper`); with
+    ``helper_holds_G`` (:func:`planner.shared_costs.held_matrix` is ``G``) half of the
+    neighbour lists there too."""
+    pairs = neighbour_pairs(G, owner, k, helper if helper_holds_G else None)
     rm = Roadmap()
     if not len(pairs):
         return rm

@@ -32,6 +32,7 @@ from planner.helper import Helper
 from planner.lns import NEAR_ABOVE, GtspLns, LnsSettings, near_holes
 from planner.pyvrp_gtsp import solve_gtsp_pyvrp
 from planner.representatives import every_representatives
+from planner.shared_costs import symmetric_costs
 from planner.timing import JointLimits
 
 #: integer cost units per second handed to OR-Tools (10 µs resolution)
@@ -177,7 +178,8 @@ class GtspSequencer:
         positions_m: NDArray[np.float64] | None = None,
         helper: Helper | None = None,
     ) -> None:
-        """``helper`` (:mod:`planner.helper`): chooses half of the holes' representatives."""
+        """``helper`` (:mod:`planner.helper`): chooses half of the holes' representatives and
+        builds half of the cost matrix (:mod:`planner.shared_costs`)."""
         if method not in SEQUENCERS:
             raise PlanningError(
                 f"unknown sequencing method {method!r} (use one of {', '.join(SEQUENCERS)})"
@@ -198,7 +200,9 @@ class GtspSequencer:
         table = CostTable(
             limits.velocity, limits.acceleration, limits.jerk, limits.upper - limits.lower
         )
-        self.G = table.matrix64(self.nodes)
+        self.G, held = symmetric_costs(table, self.nodes, helper)
+        #: the matrix the helper holds (planner.shared_costs.held_matrix), while it is ``G``
+        self.helper_G = self.G if held else None
         self.table = table
         self.positions_m = None if positions_m is None else np.asarray(positions_m, float)
         self.task_order: list[int] | None = None  # add_task_space_nodes

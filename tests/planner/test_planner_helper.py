@@ -89,3 +89,78 @@ def test_a_helper_that_died_leaves_its_share_to_this_process(cell) -> None:
     assert [np.array_equal(a.q, b.q) for (a, _), (b, _) in zip(got, want, strict=True)] == [
         True
     ] * len(holes)
+
+
+def _cost_table_and_nodes(cell, n: int):
+    from planner.costs import CostTable
+    from planner.timing import JointLimits
+
+    arm = cell.build_arm()
+    lim = JointLimits.from_arm(arm)
+    table = CostTable(lim.velocity, lim.acceleration, lim.jerk, lim.upper - lim.lower)
+    q = np.random.default_rng(7).uniform(arm.lower, arm.upper, (n, 6))
+    return arm, table, q
+
+
+def test_cost_matrix_built_with_a_helper_equals_one_process(cell) -> None:
+    from planner.shared_costs import SHARED_MIN_NODES, split_row, symmetric_costs
+
+    n = SHARED_MIN_NODES + 77  # a last block shorter than the others
+    arm, table, q = _cost_table_and_nodes(cell, n)
+    want = table.matrix64(q)
+    assert 0 < split_row(n) < n
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
+        got, held = symmetric_costs(table, q, helper)
+    assert held and got.dtype == np.float64 and np.array_equal(got, want)
+    got[3, 5] = 9.0  # a writable array, as the sequencer learns costs into it
+    assert got[3, 5] == 9.0
+    import pickle
+
+    copy = pickle.loads(pickle.dumps(got))  # a start's own copy (planner.shared.unpack)
+    copy[3, 5] = 1.0
+    assert np.array_equal(copy[:3], got[:3]) and got[3, 5] == 9.0
+
+
+def test_a_dead_helper_leaves_the_whole_cost_matrix_to_this_process(cell) -> None:
+    import os
+    import signal
+
+    from planner.shared_costs import SHARED_MIN_NODES, symmetric_costs
+
+    arm, table, q = _cost_table_and_nodes(cell, SHARED_MIN_NODES)
+    helper = Helper.start(MIN_HOLES, arm=arm)
+    for pid in list(helper.pool._processes):
+        os.kill(pid, signal.SIGKILL)
+    got, held = symmetric_costs(table, q, helper)
+    helper.close()
+    assert not held
+    assert np.array_equal(got, table.matrix64(q))
+
+
+def test_split_row_halves_the_upper_triangle() -> None:
+    from planner.costs import SYMMETRIC_BLOCK
+    from planner.shared_costs import split_row
+
+    for n in (1024, 2049, 4001):
+        r0 = split_row(n)
+        assert r0 % SYMMETRIC_BLOCK == 0
+        first = sum((n - i) for i in range(r0))  # upper-triangle entries of rows < r0
+        assert abs(first / (n * (n + 1) / 2) - 0.5) < 0.1
+
+
+def test_neighbour_lists_made_half_in_the_helper_equal_one_process(cell) -> None:
+    from planner.roadmap import neighbour_pairs
+    from planner.shared_costs import SHARED_MIN_NODES, symmetric_costs
+
+    n = SHARED_MIN_NODES + 300
+    arm, table, q = _cost_table_and_nodes(cell, n)
+    owner = np.concatenate([[-1], np.arange(n - 1) // 7])  # home, then holes of 7 nodes
+    with Helper.start(MIN_HOLES, arm=arm) as helper:
+        G, held = symmetric_costs(table, q, helper)
+        assert held
+        far = n - 3  # a later write here (a learned cost) is seen by the helper too
+        G[far, 2] = G[2, far] = 0.0
+        got = neighbour_pairs(G, owner, 5, helper)
+    want = neighbour_pairs(G, owner, 5)
+    assert np.array_equal(got, want)
+    assert [2, far] in want.tolist()
