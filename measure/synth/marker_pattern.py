@@ -239,18 +239,11 @@ def marker_patch(
                 if val != OUTSIDE:
                     out[yy, xx] = (black * (1.0 - val) + white_level * val) * lit[yy, xx]
                 continue
-            x, y, rx_x, ry_x, rx_y, ry_y = _ray(
-                gnx, gny, gx0, gy0, step, float(box[0] + xx), float(box[1] + yy)
+            den, u, v, ux, uy, vx, vy = _uv(
+                gnx, gny, gx0, gy0, step, H, float(box[0] + xx), float(box[1] + yy)
             )
-            den = H[2, 0] * x + H[2, 1] * y + H[2, 2]
             if den <= 0.0:
                 continue
-            u = (H[0, 0] * x + H[0, 1] * y + H[0, 2]) / den
-            v = (H[1, 0] * x + H[1, 1] * y + H[1, 2]) / den
-            au, bu = (H[0, 0] - u * H[2, 0]) / den, (H[0, 1] - u * H[2, 1]) / den
-            av, bv = (H[1, 0] - v * H[2, 0]) / den, (H[1, 1] - v * H[2, 1]) / den
-            ux, uy = au * rx_x + bu * ry_x, au * rx_y + bu * ry_y
-            vx, vy = av * rx_x + bv * ry_x, av * rx_y + bv * ry_y
             r = math.sqrt(u * u + v * v) + 1e-12
             rx, ry = (u * ux + v * vx) / r, (u * uy + v * vy) / r  # grad r, per pixel
             g = math.sqrt(rx * rx + ry * ry) + 1e-300
