@@ -3,13 +3,17 @@
 A tour's views (the calibration's, the survey's) are detected while the arm moves on. A camera
 that can take a snapshot (the simulated head: ``snapshot()`` returns a picklable function that
 renders the pair it saw) has its pairs rendered in the workers too, so the arm never waits for a
-render. :func:`executor` gives the workers; :func:`pair_source` what one capture hands them.
+render. :func:`executor` gives the workers (one pool per process, kept from tour to tour, so
+their start-up and the renderer's per-camera caches are paid once); :func:`pair_source` what
+one capture hands them.
 """
 
 from __future__ import annotations
 
 import multiprocessing
+import threading
 from collections.abc import Callable
+from concurrent import futures
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from typing import Any
 
@@ -34,13 +38,47 @@ class InProcess(Executor):
         return future
 
 
+class Shared(Executor):
+    """One user's view of the process's shared pool: :meth:`shutdown` cancels (and with
+    ``wait`` awaits) the jobs submitted through it, and leaves the workers running for the
+    next user (their imports and the renderer's per-camera caches are paid once)."""
+
+    def __init__(self, pool: ProcessPoolExecutor) -> None:
+        self._pool = pool
+        self._jobs: list[Future] = []
+
+    def submit(self, fn, /, *args, **kwargs) -> Future:  # type: ignore[override]
+        self._jobs = [f for f in self._jobs if not f.done()]
+        future = self._pool.submit(fn, *args, **kwargs)
+        self._jobs.append(future)
+        return future
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        if cancel_futures:
+            for f in self._jobs:
+                f.cancel()
+        if wait:
+            futures.wait(self._jobs)
+        self._jobs = []
+
+
+#: the process's worker pools by size, started on first use and kept until the process ends
+_POOLS: dict[int, ProcessPoolExecutor] = {}
+_POOLS_LOCK = threading.Lock()
+
+
 def executor(workers: int) -> Executor:
     """``workers`` processes started by a fork server (a process that runs a simulator holds
-    threads whose locks a forked child would inherit locked), or this process."""
+    threads whose locks a forked child would inherit locked), shared by the tours of this
+    process (:class:`Shared`; a pool whose worker died is started again), or this process."""
     if workers <= 0:
         return InProcess()
-    ctx = multiprocessing.get_context("forkserver")
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    with _POOLS_LOCK:
+        pool = _POOLS.get(workers)
+        if pool is None or getattr(pool, "_broken", False):
+            ctx = multiprocessing.get_context("forkserver")
+            pool = _POOLS[workers] = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    return Shared(pool)
 
 
 def pair_source(camera: Any) -> tuple[PairSource, bool]:

@@ -20,11 +20,12 @@ from cell.review.audit_images import save_pair
 
 
 class PairsAhead:
-    """Captures of ``camera`` whose pairs come later: rendered in ``workers`` processes when
-    the camera takes snapshots; ``keep_dir``: the run directory the pairs are kept in (None:
+    """Captures of ``camera`` whose pairs come later: rendered in the process's pool of
+    ``workers`` processes (:func:`cell.camera.workers.executor`) when the camera takes
+    snapshots, one stop ahead; ``keep_dir``: the run directory the pairs are kept in (None:
     none kept)."""
 
-    def __init__(self, camera: CameraBackend, keep_dir: Path | None, workers: int = 1) -> None:
+    def __init__(self, camera: CameraBackend, keep_dir: Path | None, workers: int = 2) -> None:
         self.camera, self.keep_dir = camera, keep_dir
         snapshots = getattr(camera, "snapshot", None) is not None
         self._pool: Executor = executor(workers) if snapshots else InProcess()
@@ -46,7 +47,7 @@ class PairsAhead:
         return self._pool.submit(render_and_keep, source, keep_dir, stop_index, hole_id)
 
     def close(self) -> None:
-        """Stop the workers (a capture not yet rendered is dropped)."""
+        """Drop a capture not yet rendered (the process's workers stay for the next user)."""
         self._pool.shutdown(wait=True, cancel_futures=True)
 
 
