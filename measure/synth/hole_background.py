@@ -4,14 +4,12 @@ surface level times the vignetting is the same for every view of a camera: cache
 
 from __future__ import annotations
 
-import threading
-from collections import OrderedDict
-
 import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
 from measure.synth.hole_scene import HoleGeometry, Shading
+from measure.synth.lru import Lru
 from measure.synth.optics import frame_ray_grid, vignetting
 from measure.synth.pixel_rays import pixel_rays_key
 from measure.synth.texture import TEXEL_M, sample_texture
@@ -47,19 +45,16 @@ def background(
 
 #: how many (camera, surface level, vignetting) half-resolution light maps are kept (5 MB each)
 CACHE_LIGHT = 8
-_light_maps: OrderedDict[tuple, np.ndarray] = OrderedDict()
-_lock = threading.Lock()
+_light_maps = Lru(CACHE_LIGHT)
 
 
 def _lit_half(stereo: StereoCalibration, side: str, surface: float, vig: float) -> np.ndarray:
     """``surface`` times the vignetting at the half-resolution background's pixels (float32,
     read-only; cached per camera: the same for every view)."""
     key = (pixel_rays_key(stereo, side), float(surface), float(vig))
-    with _lock:
-        hit = _light_maps.get(key)
-        if hit is not None:
-            _light_maps.move_to_end(key)
-            return hit
+    hit = _light_maps.lookup(key)
+    if hit is not None:
+        return hit
     w, h = stereo.image_size
     step = 16.0
     grid = frame_ray_grid(stereo, side, step)
@@ -75,8 +70,4 @@ def _lit_half(stereo: StereoCalibration, side: str, surface: float, vig: float) 
                         borderMode=cv2.BORDER_REPLICATE)  # fmt: skip
     lit = surface * Vh
     lit.setflags(write=False)
-    with _lock:
-        _light_maps[key] = lit
-        while len(_light_maps) > CACHE_LIGHT:
-            _light_maps.popitem(last=False)
-    return lit
+    return _light_maps.keep(key, lit)

@@ -8,8 +8,6 @@ the optics blur); the camera's noise and quantisation are those of
 
 from __future__ import annotations
 
-import threading
-from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -17,6 +15,7 @@ import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
+from measure.synth.lru import Lru
 from measure.synth.marker_draw import MarkerPatch, draw_markers
 from measure.synth.optics import vignetting
 from measure.synth.pixel_rays import pixel_rays_key
@@ -39,8 +38,7 @@ class MarkerRender:
 
 #: how many survey backgrounds (camera, surface level, vignetting) are kept (20 MB each at 5 MP)
 CACHE_BACKGROUNDS = 4
-_backgrounds: OrderedDict[tuple, np.ndarray] = OrderedDict()
-_lock = threading.Lock()
+_backgrounds = Lru(CACHE_BACKGROUNDS)
 
 
 def _background(stereo: StereoCalibration, side: str, opts: RenderOptions) -> np.ndarray:
@@ -48,11 +46,9 @@ def _background(stereo: StereoCalibration, side: str, opts: RenderOptions) -> np
     (those of :func:`measure.synth.optics.ray_grid` over the image); cached per camera and
     levels: every survey view of a camera has the same."""
     key = (pixel_rays_key(stereo, side), float(opts.surface), float(opts.vignetting))
-    with _lock:
-        hit = _backgrounds.get(key)
-        if hit is not None:
-            _backgrounds.move_to_end(key)
-            return hit
+    hit = _backgrounds.lookup(key)
+    if hit is not None:
+        return hit
     w, h = stereo.image_size
     step = 16.0
     cols, rows = int(np.ceil(w / step)) + 3, int(np.ceil(h / step)) + 3
@@ -66,11 +62,7 @@ def _background(stereo: StereoCalibration, side: str, opts: RenderOptions) -> np
     flags = cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP
     img = cv2.warpAffine(small, M, (w, h), flags=flags, borderMode=cv2.BORDER_REPLICATE)
     img.setflags(write=False)
-    with _lock:
-        _backgrounds[key] = img
-        while len(_backgrounds) > CACHE_BACKGROUNDS:
-            _backgrounds.popitem(last=False)
-    return img
+    return _backgrounds.keep(key, img)
 
 
 def render_markers_pair(

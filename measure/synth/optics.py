@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from measure.calibration import StereoCalibration
+from measure.synth.lru import Lru
 from measure.synth.pixel_rays import pixel_rays_key
 
 
@@ -80,8 +79,7 @@ def ray_grid(
 
 #: how many cameras' full-frame ray grids :func:`frame_ray_grid` keeps
 CACHE_GRIDS = 8
-_grids: OrderedDict[tuple, RayGrid] = OrderedDict()
-_lock = threading.Lock()
+_grids = Lru(CACHE_GRIDS)
 
 
 def frame_ray_grid(stereo: StereoCalibration, side: str, step: float) -> RayGrid:
@@ -89,19 +87,13 @@ def frame_ray_grid(stereo: StereoCalibration, side: str, step: float) -> RayGrid
     model (read-only arrays): every render of a camera asks for the same one."""
     w, h = stereo.image_size
     key = (pixel_rays_key(stereo, side), float(step))
-    with _lock:
-        hit = _grids.get(key)
-        if hit is not None:
-            _grids.move_to_end(key)
-            return hit
+    hit = _grids.lookup(key)
+    if hit is not None:
+        return hit
     grid = ray_grid(stereo, side, 0.0, 0.0, w, h, step)
     grid.nx.setflags(write=False)
     grid.ny.setflags(write=False)
-    with _lock:
-        _grids[key] = grid
-        while len(_grids) > CACHE_GRIDS:
-            _grids.popitem(last=False)
-    return grid
+    return _grids.keep(key, grid)
 
 
 def vignetting(

@@ -12,14 +12,13 @@ point-sampling renderer as the reference.
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
 from measure.calibration import StereoCalibration
+from measure.synth.lru import Lru
 from measure.synth.pixel_rays import pixel_rays, pixel_rays_key
 from measure.synth.sensor import quantize_u8
 from measure.synth.target_pattern import CHESSBOARD, CIRCLES, plate_image, plate_region
@@ -143,19 +142,16 @@ BLUR_MARGIN_PX, ALIGN_PX = 8, 64
 #: how many (camera, light, blur) surrounds are kept (20 MB each at 5 MP)
 CACHE_SURROUNDS = 4
 
-_surrounds: OrderedDict[tuple, np.ndarray] = OrderedDict()
-_lock = threading.Lock()
+_surrounds = Lru(CACHE_SURROUNDS)
 
 
 def _surround(stereo: StereoCalibration, side: str, blur: float) -> np.ndarray:
     """The frame with no plate in view, lit and blurred ((h, w) float32, read-only; cached):
     what every pixel far from the plate shows."""
     key = (pixel_rays_key(stereo, side), VIGNETTING, 255.0, float(blur))
-    with _lock:
-        hit = _surrounds.get(key)
-        if hit is not None:
-            _surrounds.move_to_end(key)
-            return hit
+    hit = _surrounds.lookup(key)
+    if hit is not None:
+        return hit
     w, h = stereo.image_size
     nx = np.zeros((1, 1), dtype=np.float32)  # no plate pixel: only the light matters, no ray
     nx.setflags(write=False)
@@ -166,11 +162,7 @@ def _surround(stereo: StereoCalibration, side: str, blur: float) -> np.ndarray:
     if blur > 0:
         img = cv2.GaussianBlur(img, (0, 0), blur)
     img.setflags(write=False)
-    with _lock:
-        _surrounds[key] = img
-        while len(_surrounds) > CACHE_SURROUNDS:
-            _surrounds.popitem(last=False)
-    return img
+    return _surrounds.keep(key, img)
 
 
 def _region(box, blur: float, w: int, h: int) -> tuple[tuple[int, int, int, int], tuple]:
