@@ -12,7 +12,9 @@ their wall and CPU time, summed over the views, are the workers' own figures
 stage the survey's wall time is made of (``survey: tour driven``).
 
 The calibration tour renders and detects its views in worker processes as the survey does (its
-walls: ``calibration tour walls``); the run renders each stop's pair in a worker while it
+walls: ``calibration tour walls``), and its adjustment runs in a worker while the survey is
+driven (``calibration: wait for the solve (worker)``: what is left of it after the survey); the
+run renders each stop's pair in a worker while it
 measures the stop before (its wait for a pair: ``render_s`` of the holes' laps). Renders left in
 this process are split by phase, and so is the marker detection (the reference rounds' and the
 holes').
@@ -39,7 +41,7 @@ from collections import defaultdict
 from pathlib import Path
 
 import cell.calibration.capture as capture
-import cell.calibration.capture.tour as cal_tour
+import cell.demo.calibrate as demo_calibrate
 import cell.demo.demo as demo
 import cell.run.inspect as inspect_hole
 import cell.run.reference_phase as reference_phase
@@ -58,8 +60,8 @@ TIMED = (
     ("plan: all tours", demo, "plan_demo"),
     ("plan: hole tour (this process)", tour_planner.TourPlanner, "plan"),
     ("calibration: all", demo, "_calibration"),
-    ("calibration: tour driven and solved", capture, "run_calibration_tour"),
-    ("calibration: solve", cal_tour, "solve_calibration"),
+    ("calibration: tour driven (move, render, detect)", capture, "capture_calibration_tour"),
+    ("calibration: wait for the solve (worker)", demo_calibrate.PendingCalibration, "finish"),
     ("survey: all", demo, "_survey"),
     ("survey: tour driven (move, render, detect)", survey_run, "SurveyCapture"),
     ("survey: adjust", survey_run, "survey"),
@@ -109,7 +111,7 @@ def _timed(label: str, fn):
             _add(key, time.perf_counter() - t, time.thread_time() - c)
             _phase[0] = before
         if label.startswith("calibration: tour"):
-            _runs.append(out)
+            _runs.append(out)  # a CapturedTour
         return out
 
     return wrapper

@@ -4,7 +4,22 @@ from __future__ import annotations
 
 
 class CellError(Exception):
-    """Base of every error raised by :mod:`cell`. The CLI prints its message, no traceback."""
+    """Base of every error raised by :mod:`cell`. The CLI prints its message, no traceback.
+
+    Every subclass pickles with its message and payload whatever its ``__init__`` takes (an
+    error raised in a worker process reaches the caller as raised)."""
+
+    def __reduce__(self) -> tuple:
+        return (_rebuilt, (type(self), self.args, dict(self.__dict__)))
+
+
+def _rebuilt(cls: type[CellError], args: tuple, state: dict) -> CellError:
+    """A :class:`CellError` of ``cls`` with ``args`` and attributes ``state``, without calling
+    its ``__init__``."""
+    error = cls.__new__(cls)
+    Exception.__init__(error, *args)
+    error.__dict__.update(state)
+    return error
 
 
 #: the value of a :class:`ConfigError` problem that has none to show (a YAML syntax error)

@@ -5,11 +5,16 @@ that can take a snapshot (the simulated head: ``snapshot()`` returns a picklable
 renders the pair it saw) has its pairs rendered in the workers too, so the arm never waits for a
 render. :func:`executor` gives the workers (one pool per process, kept from tour to tour, so
 their start-up and the renderer's per-camera caches are paid once); :func:`pair_source` what
-one capture hands them.
+one capture hands them. :func:`start_workers` starts them ahead of the first tour, each warming
+itself (a camera's renderer and detector) while this process still plans.
+
+Each worker runs its libraries single-threaded (OpenCV, BLAS): the workers are as many as the
+cores, and threads inside them would only compete for the same cores.
 """
 
 from __future__ import annotations
 
+import logging
 import multiprocessing
 import threading
 from collections.abc import Callable
@@ -66,6 +71,8 @@ class Shared(Executor):
 _POOLS: dict[int, ProcessPoolExecutor] = {}
 _POOLS_LOCK = threading.Lock()
 
+log = logging.getLogger(__name__)
+
 
 def executor(workers: int) -> Executor:
     """``workers`` processes started by a fork server (a process that runs a simulator holds
@@ -73,12 +80,51 @@ def executor(workers: int) -> Executor:
     process (:class:`Shared`; a pool whose worker died is started again), or this process."""
     if workers <= 0:
         return InProcess()
+    return Shared(_pool(workers, None))
+
+
+def start_workers(workers: int, warm: Callable[[], Any] | None = None) -> bool:
+    """Start the pool of ``workers`` processes now (no-op for 0, or when it runs already), each
+    process calling ``warm`` (picklable; its errors are logged, not raised) before its first
+    job; returns whether this call started it. The tours that follow use these workers
+    (:func:`executor`)."""
+    if workers <= 0:
+        return False
+    with _POOLS_LOCK:
+        pool = _POOLS.get(workers)
+        if pool is not None and not getattr(pool, "_broken", False):
+            return False
+    pool = _pool(workers, warm)
+    for _ in range(workers):  # a fork server's pool starts one process per job waiting
+        pool.submit(int)
+    return True
+
+
+def _pool(workers: int, warm: Callable[[], Any] | None) -> ProcessPoolExecutor:
+    """The process's pool of ``workers`` (started, with ``warm``, when missing or broken)."""
     with _POOLS_LOCK:
         pool = _POOLS.get(workers)
         if pool is None or getattr(pool, "_broken", False):
             ctx = multiprocessing.get_context("forkserver")
-            pool = _POOLS[workers] = ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
-    return Shared(pool)
+            pool = _POOLS[workers] = ProcessPoolExecutor(
+                max_workers=workers, mp_context=ctx, initializer=_worker_start, initargs=(warm,)
+            )
+        return pool
+
+
+def _worker_start(warm: Callable[[], Any] | None) -> None:
+    """A worker's start: its libraries single-threaded, then ``warm``."""
+    import cv2
+    from threadpoolctl import threadpool_limits
+
+    cv2.setNumThreads(1)
+    threadpool_limits(1)
+    if warm is None:
+        return
+    try:
+        warm()
+    except Exception as exc:  # a cold worker still works: say so, do not break the pool
+        log.warning("a worker's warm-up failed (%s: %s)", type(exc).__name__, exc)
 
 
 def pair_source(camera: Any) -> tuple[PairSource, bool]:

@@ -20,14 +20,17 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from cell.calibration.capture.tour import CapturedTour, finish_calibration_tour
 from cell.calibration.estimate import CellCalibration, SolveOptions, pose_error, truth_in_gauge
 from cell.calibration.file import save_calibration
 from cell.calibration.use import RUN_FILENAME
+from cell.camera.workers import executor
 from cell.config import CellConfig
 from cell.demo.caltour_cache import cached_caltour, caltour_key
 from cell.demo.sim_calibration import design_views, simulated_calibration, synthetic_truth
@@ -149,7 +152,66 @@ def calibrate_demo_cell_images(
     """Run ``caltour`` on the simulated cell at ``speed`` (x real time), detect, solve
     (:func:`cell.calibration.capture.tour.run_calibration_tour`); write ``run_dir/cellcal.json``;
     ``progress`` gets the stages of :func:`tour_stages`."""
-    from cell.calibration.capture import CalibrateCellOptions, CaptureSettings, run_calibration_tour
+    pending = start_demo_calibration_images(sim, cell, caltour, run_dir, speed, progress)
+    if progress is not None:
+        progress("solve", 0, 1)
+    cal = pending.finish()
+    if progress is not None:
+        progress("solve", 1, 1)
+    return cal
+
+
+@dataclass
+class PendingCalibration:
+    """A demo calibration whose tour is captured and whose adjustment runs in a worker process
+    (:func:`start_demo_calibration_images`); :meth:`finish` waits for it and writes the file."""
+
+    sim: SimCell
+    cell: CellConfig
+    caltour: CalibrationTour
+    run_dir: Path
+    captured: CapturedTour
+    solve: Future
+    progress: StageProgress | None
+    captured_s: float  # the tour's wall time (s)
+
+    def finish(self) -> DemoCalibration:
+        """The adjustment's result (its refusals raised here), written to
+        ``run_dir/cellcal.json`` and measured against the simulation's truth."""
+        t0 = time.perf_counter()  # the solve's own time is in the summary, not in a bar
+        run = finish_calibration_tour(self.captured, self.solve.result())
+        cal = run.result.calibration
+        path = Path(self.run_dir) / RUN_FILENAME
+        save_calibration(cal, path)
+        seconds = self.captured_s + time.perf_counter() - t0  # the survey's time left out
+        sim = self.sim
+        gauge = truth_in_gauge(synthetic_truth(self.cell, sim.world.true_geometry(),
+                                               sim.camera.stereo))  # fmt: skip
+        dp, dr = pose_error(cal.T_tool0_camera.T, gauge.T_tool0_camera)
+        fixed = tuple(t.name for t in cal.dh_terms if not t.free)
+        method = (f"calibration tour of {len(self.caltour.tour.stops)} views driven on the "
+                  f"simulated controller ({run.captures.robot_time_s:.0f} s robot time), plate "
+                  f"rendered and detected in both cameras, solve "
+                  f"{run.result.timings['total_s']:.1f} s in a worker process"
+                  + ("" if run.warming is None else f"; {run.warming.line()}"))  # fmt: skip
+        note = str(self.caltour.tour.settings.get("plan_cache", ""))
+        return DemoCalibration(path, cal, seconds, dp, dr, fixed, method, note)
+
+
+def start_demo_calibration_images(
+    sim: SimCell, cell: CellConfig, caltour: CalibrationTour, run_dir: Path, speed: float,
+    progress: StageProgress | None = None,
+) -> PendingCalibration:  # fmt: skip
+    """Drive ``caltour`` on the simulated cell at ``speed`` (x real time) and detect the plate
+    (:func:`cell.calibration.capture.tour.capture_calibration_tour`), then hand the adjustment
+    to one of the process's workers (:func:`cell.camera.workers.executor`): the survey can run
+    meanwhile, it needs no cell calibration."""
+    from cell.calibration.capture import (
+        CalibrateCellOptions,
+        CaptureSettings,
+        capture_calibration_tour,
+        solve_captured,
+    )
     from cell.link.client import ControllerClient
 
     t0 = time.perf_counter()
@@ -161,20 +223,10 @@ def calibrate_demo_cell_images(
             max_warming_K=float("inf"),  # the demo calibrates its cold arm: reported, not refused
         )  # as the CLI
         with ControllerClient(sim.url) as client:
-            run = run_calibration_tour(cell, caltour, client, sim.camera, opts,
-                                       tour_stages(progress))  # fmt: skip
+            captured = capture_calibration_tour(cell, caltour, client, sim.camera, opts,
+                                                tour_stages(progress))  # fmt: skip
     finally:
         sim.world.clock.set_speed(1.0)
-    cal = run.result.calibration
-    path = Path(run_dir) / RUN_FILENAME
-    save_calibration(cal, path)
-    seconds = time.perf_counter() - t0
-    gauge = truth_in_gauge(synthetic_truth(cell, sim.world.true_geometry(), sim.camera.stereo))
-    dp, dr = pose_error(cal.T_tool0_camera.T, gauge.T_tool0_camera)
-    fixed = tuple(t.name for t in cal.dh_terms if not t.free)
-    method = (f"calibration tour of {len(caltour.tour.stops)} views driven on the simulated "
-              f"controller ({run.captures.robot_time_s:.0f} s robot time), plate rendered and "
-              f"detected in both cameras, solve {run.result.timings['total_s']:.1f} s"
-              + ("" if run.warming is None else f"; {run.warming.line()}"))  # fmt: skip
-    note = str(caltour.tour.settings.get("plan_cache", ""))
-    return DemoCalibration(path, cal, seconds, dp, dr, fixed, method, note)
+    solve = executor(opts.capture.workers).submit(solve_captured, captured, opts.solve)
+    return PendingCalibration(sim, cell, caltour, run_dir, captured, solve, progress,
+                              time.perf_counter() - t0)  # fmt: skip

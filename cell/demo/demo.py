@@ -22,8 +22,9 @@ from cell.calibration.use import RunCalibration, load_run_calibration
 from cell.config import CellConfig, load_builtin_cell
 from cell.demo.calibrate import (
     DemoCalibration,
+    PendingCalibration,
     calibrate_demo_cell,
-    calibrate_demo_cell_images,
+    start_demo_calibration_images,
 )
 from cell.demo.plan import plan_demo
 from cell.demo.survey import (
@@ -31,6 +32,7 @@ from cell.demo.survey import (
     survey_demo_cell,
 )
 from cell.demo.truth_error import DatumError, TruthError, datum_truth_error, truth_error
+from cell.demo.warm import start_demo_workers
 from cell.link.client import ControllerClient
 from cell.referencing.network import MarkerNetwork, load_network
 from cell.referencing.survey.tour import SurveyTour
@@ -154,18 +156,21 @@ def run_demo(
     cell = load_builtin_cell()
     images = opts.calibrate and opts.realistic and opts.calibration_method == "images"
     referencing = opts.referencing and bool(cell.reference_markers)
+    # real time until the first reference round starts (its readings are the cold state)
+    world = demo_world(cell, opts)
+    start_demo_workers(cell, world)  # they warm up while this process plans
     tour, reference, caltour, planned = plan_demo(
         cell, opts.seed, plan_progress, opts.calibration_views if images else 0, referencing
     )
     t_plan = time.perf_counter() - t0
-    # real time until the first reference round starts (its readings are the cold state)
-    world = demo_world(cell, opts)
     with SimCell.start(cell, world, opts.faults) as sim:
         files = start_run(out_dir, cell, tour, "built-in tour", sim.url, reference)
         recorder = recorder_factory(Path(out_dir), cell, tour) if recorder_factory else None
         try:
-            cal, run_cal = _calibration(sim, files, opts, caltour, plan_progress)
-            surveyed, network = _survey(sim, files, opts, planned)
+            pending = _calibration(sim, files, opts, caltour, plan_progress)
+            # the calibration's adjustment runs in a worker while the survey is driven
+            surveyed, network = _survey(sim, files, opts, planned, plan_progress)
+            cal, run_cal = _calibrated(sim, files, pending)
             result = _run_sim(sim, files, opts, _speed_up(sim, opts, run_progress), recorder,
                               run_cal, network)  # fmt: skip
             truth = truth_error(sim.world, files.store.results())
@@ -190,32 +195,43 @@ def run_demo(
 
 
 def _survey(
-    sim: SimCell, files: RunFiles, opts: DemoOptions, planned: SurveyTour | None
-) -> tuple[DemoSurvey | None, MarkerNetwork | None]:
+    sim: SimCell, files: RunFiles, opts: DemoOptions, planned: SurveyTour | None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> tuple[DemoSurvey | None, MarkerNetwork | None]:  # fmt: skip
     """Survey the simulated cell's markers (``planned``: the survey tour, None: no referencing),
     write ``markers.json`` into the run directory and load it back as the run does (checked)."""
     if planned is None:
         return None, None
     surveyed = survey_demo_cell(sim, files.cell, planned, files.store.path.parent,
-                                opts.survey_speed)  # fmt: skip
+                                opts.survey_speed, progress)  # fmt: skip
     return surveyed, load_network(surveyed.path, files.cell, sim.camera.stereo)
 
 
 def _calibration(
     sim: SimCell, files: RunFiles, opts: DemoOptions, caltour: CalibrationTour | None,
     progress: Callable[[str, int, int], None] | None = None,
-) -> tuple[DemoCalibration | None, RunCalibration | None]:  # fmt: skip
-    """Calibrate the simulated cell (``opts.calibrate`` and a realistic cell), write the
-    calibration into the run directory and load it back as the run does (checked)."""
+) -> PendingCalibration | DemoCalibration | None:  # fmt: skip
+    """Calibrate the simulated cell (``opts.calibrate`` and a realistic cell) into the run
+    directory: through images, the tour driven now and its adjustment left running in a worker
+    (:func:`_calibrated` waits for it); projected, done at once; None: no calibration."""
     if not (opts.calibrate and opts.realistic):
-        return None, None
+        return None
     run_dir = files.store.path.parent
     if caltour is not None:
-        cal = calibrate_demo_cell_images(sim, files.cell, caltour, run_dir,
-                                         opts.calibration_speed, progress)  # fmt: skip
-    else:
-        cal = calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
-                                  opts.seed, progress)  # fmt: skip
+        return start_demo_calibration_images(sim, files.cell, caltour, run_dir,
+                                             opts.calibration_speed, progress)  # fmt: skip
+    return calibrate_demo_cell(sim, files.cell, files.tour, run_dir, opts.calibration_views,
+                               opts.seed, progress)  # fmt: skip
+
+
+def _calibrated(
+    sim: SimCell, files: RunFiles, pending: PendingCalibration | DemoCalibration | None
+) -> tuple[DemoCalibration | None, RunCalibration | None]:
+    """The calibration of :func:`_calibration` (finished), loaded back as the run does
+    (checked)."""
+    if pending is None:
+        return None, None
+    cal = pending.finish() if isinstance(pending, PendingCalibration) else pending
     arm = files.cell.build_robot()
     return cal, load_run_calibration(cal.path, files.cell, arm, sim.camera.stereo)
 

@@ -6,6 +6,7 @@ simulator's true markers."""
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -82,6 +83,18 @@ def plan_demo_survey(seed: int, cached_only: bool = False) -> dict | None:
     return data
 
 
+def _views(progress: Callable[[str, int, int], None] | None) -> Callable[[str, dict], None] | None:
+    """The survey's "view" events as the ``survey`` stage."""
+    if progress is None:
+        return None
+
+    def report(event: str, data: dict) -> None:
+        if event == "view":
+            progress("survey", data["k"], data["n"])
+
+    return report
+
+
 def survey_tour_from_dict(data: dict) -> SurveyTour:
     """The inverse of :func:`plan_demo_survey`."""
     from planner.tour import tour_from_dict
@@ -92,9 +105,11 @@ def survey_tour_from_dict(data: dict) -> SurveyTour:
 
 
 def survey_demo_cell(
-    sim: SimCell, cell: CellConfig, planned: SurveyTour, run_dir: Path, speed: float
-) -> DemoSurvey:
-    """Run the survey tour at ``speed`` (x real time), adjust, write ``run_dir/markers.json``."""
+    sim: SimCell, cell: CellConfig, planned: SurveyTour, run_dir: Path, speed: float,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> DemoSurvey:  # fmt: skip
+    """Run the survey tour at ``speed`` (x real time), adjust, write ``run_dir/markers.json``;
+    ``progress`` gets the ``survey`` stage (views detected, of the tour's)."""
     from cell.link.client import ControllerClient
 
     t0 = time.perf_counter()
@@ -102,7 +117,7 @@ def survey_demo_cell(
     try:
         with ControllerClient(sim.url) as client:
             done = run_survey(cell, planned, client, sim.camera, sim.camera.stereo,
-                              SurveyRunOptions(settle_s=0.2 / speed))  # fmt: skip
+                              SurveyRunOptions(settle_s=0.2 / speed), _views(progress))  # fmt: skip
     finally:
         sim.world.clock.set_speed(1.0)
     path = Path(run_dir) / MARKERS_FILENAME

@@ -78,8 +78,11 @@ def test_aravis_own_tool_grabs_from_holecell_sim() -> None:
         lines = [sim.stdout.readline() for _ in range(3)]
         assert "camera      gige://127.0.0.1,127.0.0.2\n" in lines, lines
         # both cameras at once, so that both take the same renders (a render of the simulated
-        # head takes 0.3 s, seconds on a loaded machine: a long grab, a slow trigger)
-        tools = [subprocess.Popen(["arv-camera-test-0.8", "-n", ip, "-o", "2", "--duration", "10"],
+        # head takes 0.3 s, seconds on a loaded machine: a long grab, a slow trigger); a socket
+        # buffer sized to the frame (-a) and a frame waited for up to 5 s (-m, -p, -l): a
+        # loaded machine's stream thread, late to read, lost packets with the tool's defaults
+        tools = [subprocess.Popen(["arv-camera-test-0.8", "-n", ip, "-o", "2", "--duration", "10",
+                                   "-a", "-m", "5000", "-p", "1000", "-l", "1000"],
                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
                  for ip in ("127.0.0.1", "127.0.0.2")]  # fmt: skip
         for tool in tools:

@@ -19,27 +19,35 @@ from cell.calibration.capture.orient import (
 )
 from cell.calibration.capture.tour import (
     CalibrateCellOptions,
+    CapturedTour,
     CellCalibrationRun,
     calibrate_cell,
+    capture_calibration_tour,
     check_calibration_tour,
+    finish_calibration_tour,
     observations_of,
     run_calibration_tour,
+    solve_captured,
 )
 
 __all__ = [
     "PLANE_TOLERANCE_PX",
     "CalibrateCellOptions",
     "CaptureSettings",
+    "CapturedTour",
     "CapturedView",
     "CellCalibrationRun",
     "TourCapture",
     "TourCaptures",
     "calibrate_cell",
+    "capture_calibration_tour",
     "check_calibration_tour",
+    "finish_calibration_tour",
     "observations_of",
     "orient_chessboard",
     "plane_outliers",
     "refine_corners",
     "repair_outliers",
     "run_calibration_tour",
+    "solve_captured",
 ]

@@ -25,7 +25,7 @@ from cell.calibration.capture.capture import (
 from cell.calibration.capture.warming import MAX_K, TourWarming, check_warming, tour_warming
 from cell.calibration.errors import CalibrationDataError
 from cell.calibration.estimate.observations import CalibrationObservations, CalibrationView, Cameras
-from cell.calibration.estimate.result import CellCalibration
+from cell.calibration.estimate.result import CellCalibration, Provenance
 from cell.calibration.estimate.soft_views import DroppedView, is_soft, solve_without
 from cell.calibration.estimate.solve import CalibrationResult, SolveOptions, solve_calibration
 from cell.calibration.file.provenance import cell_provenance
@@ -37,6 +37,7 @@ from cell.link.client import ControllerClient
 from measure.target import TargetSpec
 from planner import TourCellMismatchError, check_tour_for_cell
 from planner.calibration import CalibrationTour
+from robots.dh import DHTable
 
 
 @dataclass(frozen=True)
@@ -129,6 +130,22 @@ def observations_of(
     return CalibrationObservations(tuple(views), spec, cameras, source)
 
 
+@dataclass(frozen=True, eq=False)
+class CapturedTour:
+    """A calibration tour driven and detected, not yet solved (:func:`capture_calibration_tour`):
+    the captures, the arm's warming, the observations, the views dropped, the nominal D-H
+    table, the provenance and when the tour started (``time.perf_counter``)."""
+
+    captures: TourCaptures
+    warming: TourWarming | None
+    observations: CalibrationObservations
+    dropped: tuple[DroppedView, ...]
+    dh: DHTable
+    provenance: Provenance
+    source: str
+    t0: float
+
+
 def run_calibration_tour(
     cell: CellConfig,
     tour: CalibrationTour,
@@ -138,12 +155,32 @@ def run_calibration_tour(
     progress: Progress | None = None,
     source: str = "calibration tour",
 ) -> CellCalibrationRun:
-    """Run ``tour`` on ``client`` (connected), capture with ``camera``, detect, solve.
+    """Run ``tour`` on ``client`` (connected), capture with ``camera``, detect, solve
+    (:func:`capture_calibration_tour`, then :func:`finish_calibration_tour`).
 
     Raises :class:`CalibrationDataError` (a view without the target, naming it),
     :class:`cell.calibration.errors.DegenerateCalibrationError` (too few views, degenerate
     rotations, an undetermined hand-eye), :class:`cell.link.motion.RunFaultError` (a controller
     fault: the arm is stopped) or :class:`CellError` (a tour of another cell or board)."""
+    o = options or CalibrateCellOptions()
+    captured = capture_calibration_tour(cell, tour, client, camera, o, progress, source)
+    report = progress or (lambda event, data: None)
+    report("solve", {"views": len(captured.observations.views)})
+    result = solve_captured(captured, o.solve)
+    return finish_calibration_tour(captured, result, progress)
+
+
+def capture_calibration_tour(
+    cell: CellConfig,
+    tour: CalibrationTour,
+    client: ControllerClient,
+    camera: CameraBackend,
+    options: CalibrateCellOptions | None = None,
+    progress: Progress | None = None,
+    source: str = "calibration tour",
+) -> CapturedTour:
+    """The first half of :func:`run_calibration_tour`: the tour driven, the target detected, the
+    warming checked, the observations gathered (its refusals)."""
     o = options or CalibrateCellOptions()
     report = progress or (lambda event, data: None)
     t0 = time.perf_counter()
@@ -159,17 +196,41 @@ def run_calibration_tour(
     obs = observations_of(captures, spec, cameras, source, o.capture.strict, dropped)
     for d in dropped:
         report("dropped", {"warning": d.warning(source, len(obs.views))})
-    report("solve", {"views": len(obs.views)})
     dh = cell.build_robot().dh
     stereo_source = str(cell.calibration_path() or camera.stereo.source)
     prov = cell_provenance(cell, dh, stereo_source, camera.stereo.to_dict())
-    result = solve_without(dropped, source, solve_calibration, obs, dh, o.solve, prov)
-    if warming is not None:  # kept with the calibration
-        cal = replace(result.calibration, notes=(*result.calibration.notes, warming.line()))
+    return CapturedTour(captures, warming, obs, tuple(dropped), dh, prov, source, t0)
+
+
+def solve_captured(captured: CapturedTour, options: SolveOptions) -> CalibrationResult:
+    """The adjustment of a captured tour (picklable in and out: it may run in a worker
+    process; the captures themselves are not needed)."""
+    return solve_observations(captured.observations, captured.dh, options,
+                              captured.provenance, captured.dropped, captured.source)  # fmt: skip
+
+
+def solve_observations(
+    obs: CalibrationObservations, dh: DHTable, options: SolveOptions, provenance: Provenance,
+    dropped: tuple[DroppedView, ...], source: str,
+) -> CalibrationResult:  # fmt: skip
+    """:func:`solve_calibration` of ``obs``, the ``dropped`` views' refusal rules applied."""
+    return solve_without(list(dropped), source, solve_calibration, obs, dh, options, provenance)
+
+
+def finish_calibration_tour(
+    captured: CapturedTour, result: CalibrationResult, progress: Progress | None = None
+) -> CellCalibrationRun:
+    """The second half of :func:`run_calibration_tour`: the solved calibration with the tour's
+    warming noted, and the run's record."""
+    if captured.warming is not None:  # kept with the calibration
+        cal = replace(result.calibration,
+                      notes=(*result.calibration.notes, captured.warming.line()))  # fmt: skip
         result = replace(result, calibration=cal)
-    report("done", {"total_s": result.timings["total_s"]})
-    return CellCalibrationRun(captures, obs, result, time.perf_counter() - t0, tuple(dropped),
-                              warming)  # fmt: skip
+    if progress is not None:
+        progress("done", {"total_s": result.timings["total_s"]})
+    return CellCalibrationRun(captured.captures, captured.observations, result,
+                              time.perf_counter() - captured.t0, captured.dropped,
+                              captured.warming)  # fmt: skip
 
 
 def warning_or(warn: str, warming: TourWarming) -> str:
