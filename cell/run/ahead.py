@@ -2,37 +2,47 @@
 
 The runner captures stop ``k`` and then, with the arm waiting at ``k``, measures stop ``k - 1``:
 a real head's pair is already there; the simulated head's snapshot (:mod:`cell.camera.workers`)
-is rendered in a worker process meanwhile, and kept in the run directory there too, so that the
-cell computer's two cores render one stop and measure another. Each stop is still measured from
-its own pair, in the tour's order, so the results are those of one stop after another.
+is rendered in a worker process meanwhile, kept in the run directory and its markers detected
+there too, so that the cell computer's two cores render one stop and measure another. Each
+stop is still measured from its own pair, in the tour's order, so the results are those of one
+stop after another.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from concurrent.futures import Executor, Future
 from pathlib import Path
 
 from cell.camera import CameraBackend, StereoPair
 from cell.camera.errors import PairError
 from cell.camera.workers import InProcess, PairSource, executor, pair_source, rendered
+from cell.referencing.detection import Detections, detect_pair
 from cell.review.audit_images import save_pair
+from measure import StereoCalibration
 
 
 class PairsAhead:
     """Captures of ``camera`` whose pairs come later: rendered in the process's pool of
     ``workers`` processes (:func:`cell.camera.workers.executor`) when the camera takes
     snapshots, one stop ahead; ``keep_dir``: the run directory the pairs are kept in (None:
-    none kept)."""
+    none kept); ``markers``: the head and the marker codes to find in each rendered pair."""
 
-    def __init__(self, camera: CameraBackend, keep_dir: Path | None, workers: int = 2) -> None:
+    def __init__(
+        self, camera: CameraBackend, keep_dir: Path | None, workers: int = 2,
+        markers: tuple[StereoCalibration, Mapping[int, str]] | None = None,
+    ) -> None:  # fmt: skip
         self.camera, self.keep_dir = camera, keep_dir
+        self.markers = (markers[0], dict(markers[1])) if markers and markers[1] else None
         snapshots = getattr(camera, "snapshot", None) is not None
         self._pool: Executor = executor(workers) if snapshots else InProcess()
 
     def capture(self, stop_index: int, hole_id: str, keep: bool = True) -> Future:
-        """Trigger the head now; the future gives ``(pair, kept)``: the pair, and whether it
-        was kept already (``stop_index``, ``hole_id``: its file names), or raises the camera's
+        """Trigger the head now; the future gives ``(pair, kept, detections)``: the pair,
+        whether it was kept already (``stop_index``, ``hole_id``: its file names) and the
+        markers found in it (:func:`cell.referencing.detection.detect_pair`; None: not looked
+        for, as with a camera's own pair, which the caller detects), or raises the camera's
         :class:`PairError`."""
         future: Future = Future()
         try:
@@ -41,10 +51,11 @@ class PairsAhead:
             future.set_exception(exc)
             return future
         if is_pair:
-            future.set_result((source, False))
+            future.set_result((source, False, None))
             return future
         keep_dir = self.keep_dir if keep else None
-        return self._pool.submit(render_and_keep, source, keep_dir, stop_index, hole_id)
+        return self._pool.submit(render_and_keep, source, keep_dir, stop_index, hole_id,
+                                 self.markers)  # fmt: skip
 
     def close(self) -> None:
         """Drop a capture not yet rendered (the process's workers stay for the next user)."""
@@ -52,15 +63,17 @@ class PairsAhead:
 
 
 def render_and_keep(
-    source: PairSource, keep_dir: Path | None, stop_index: int, hole_id: str
-) -> tuple[StereoPair, bool]:
-    """The pair of ``source``, kept in ``keep_dir`` when given; and whether it was kept. Runs
-    in a worker process."""
+    source: PairSource, keep_dir: Path | None, stop_index: int, hole_id: str,
+    markers: tuple[StereoCalibration, Mapping[int, str]] | None = None,
+) -> tuple[StereoPair, bool, Detections | None]:  # fmt: skip
+    """The pair of ``source``, kept in ``keep_dir`` when given; whether it was kept; and with
+    ``markers`` (the head, the codes) the markers found in it. Runs in a worker process."""
     pair, _ = rendered(source)
+    dets = None if markers is None else detect_pair(pair.left, pair.right, *markers)
     if keep_dir is None:
-        return pair, False
+        return pair, False, dets
     save_pair(keep_dir, stop_index, hole_id, pair.left, pair.right)
-    return pair, True
+    return pair, True, dets
 
 
 class Laps:

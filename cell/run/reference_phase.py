@@ -75,10 +75,11 @@ class ReferencePhase(Motion):
         record it, or record why not."""
         with computing(self.camera):  # the arm waits while the computer works
             try:
-                pair, _ = pair.result()
+                pair, _, dets = pair.result()
                 exclude = None
                 if self.codes:  # the markers' labels are not the reference target
-                    dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
+                    if dets is None:
+                        dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
                     exclude = label_circles(dets)
                 meas = measure_hole(pair.left, pair.right, self.stereo, exclude=exclude)
             except (MeasurementError, PairError) as exc:

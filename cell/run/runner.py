@@ -189,7 +189,9 @@ class Runner(ReferencePhase):
         todo = [k for k, s in enumerate(self.tour.stops) if s.hole_id not in stored]
         result.skipped = [s.hole_id for s in self.tour.stops if s.hole_id in stored]
         keep_dir = self.store.path.parent if self.options.keep_images else None
-        with closing(PairsAhead(self.camera, keep_dir)) as self.ahead:
+        with closing(
+            PairsAhead(self.camera, keep_dir, markers=(self.stereo, self.codes))
+        ) as self.ahead:
             self._stops(todo, result)
 
     def _stops(self, todo: list[int], result: RunResult) -> None:
@@ -339,23 +341,25 @@ class Runner(ReferencePhase):
         with computing(self.camera):  # the arm waits at its stop while the computer works
             clock.skip()  # the next stop's move and capture: that stop's laps
             try:
-                pair, kept = future.result()
+                pair, kept, dets = future.result()
             except PairError as exc:  # no pair of one trigger: this stop fails, the run goes on
                 hole, laps = self._uncaptured(k, stop.hole_id, exc, st, clock)
             else:
                 clock.lap("render_s")
-                hole, laps = self._process_pair(k, stop, pair, st, clock, kept)
+                hole, laps = self._process_pair(k, stop, pair, st, clock, kept, dets)
         result.stored.append(hole)
         result.hole_timings.append(laps)
 
-    def _process_pair(self, k: int, stop, pair, st, clock: Laps, kept: bool
+    def _process_pair(self, k: int, stop, pair, st, clock: Laps, kept: bool, dets=None
                       ) -> tuple[HoleResult, dict[str, float]]:  # fmt: skip
-        """Locate, measure, compensate, compare, store and record stop ``k``'s pair."""
+        """Locate, measure, compensate, compare, store and record stop ``k``'s pair (``dets``:
+        its markers, when found with its render)."""
         T_arm = (T_cell_tcp(self.geometry, self.model, st.q_rad, st.temperatures_c)
                  @ self._T_head_left)  # the arm's idea of the left camera  # fmt: skip
         located, exclude = None, None
         if self.codes:  # markers in the cell: found, so that no label is taken for the hole
-            dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
+            if dets is None:
+                dets = detect_pair(pair.left, pair.right, self.stereo, self.codes)
             exclude = label_circles(dets)
             if self.markers is not None:
                 located = locate_stop(self.markers, dets, T_arm, stop.hole_id)

@@ -11,8 +11,10 @@ import pytest
 
 from cell.camera.workers import executor
 from cell.config.markers import marker_codes, marker_in_cell
+from cell.referencing.detection import detect_pair
 from cell.referencing.survey.capture import observe_view
 from cell.referencing.survey.plan import survey_views
+from cell.run.ahead import PairsAhead
 from cell.sim.camera import SimCamera
 from cell.sim.truth import CellTruth
 from cell.sim.world import SimWorld, WorldOptions
@@ -88,3 +90,20 @@ def test_views_from_worker_processes_equal_views_from_this_process(scenes, small
             for mid in da:
                 np.testing.assert_array_equal(da[mid], db[mid])
         np.testing.assert_array_equal(a.T_cell_left_prior, b.T_cell_left_prior)
+
+
+def test_a_stop_rendered_ahead_comes_with_the_markers_its_pair_shows(scenes, small_cell, stereo):
+    _vid, _T, cam = scenes[1]
+    codes = marker_codes(small_cell.reference_markers)
+    ahead = PairsAhead(cam, None, markers=(stereo, codes))
+    try:
+        pair, kept, dets = ahead.capture(0, "H1").result()
+    finally:
+        ahead.close()
+    assert not kept
+    here = detect_pair(pair.left, pair.right, stereo, codes)
+    assert len(dets[0]) >= 4 and len(dets[1]) >= 4
+    for found, expected in zip(dets, here, strict=True):
+        assert [d.code for d in found] == [d.code for d in expected]
+        for a, b in zip(found, expected, strict=True):
+            np.testing.assert_array_equal(a.center_px, b.center_px)
