@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -146,11 +147,14 @@ DETECT_MAX_SIDE_PX = 1280
 
 
 def detection_copy(img: np.ndarray) -> tuple[np.ndarray, float]:
-    """``img`` scaled to at most :data:`DETECT_MAX_SIDE_PX` (INTER_AREA) and the scale."""
-    scale = min(1.0, DETECT_MAX_SIDE_PX / max(img.shape[:2]))
-    if scale == 1.0:
+    """``img`` shrunk by the smallest whole factor that brings it to at most
+    :data:`DETECT_MAX_SIDE_PX` (INTER_AREA: the mean of each factor x factor block, OpenCV's
+    fast path; a 5 MP image in 2 ms instead of 8), and the scale (1 / factor)."""
+    factor = math.ceil(max(img.shape[:2]) / DETECT_MAX_SIDE_PX)
+    if factor <= 1:
         return img, 1.0
-    return cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA), scale
+    h, w = img.shape[:2]
+    return cv2.resize(img, (w // factor, h // factor), interpolation=cv2.INTER_AREA), 1.0 / factor
 
 
 def _find_chessboard(img: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray | None, str]:

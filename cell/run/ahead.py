@@ -1,11 +1,11 @@
-"""A stop's pair on its way while the computer works on the stop before.
+"""Stops' pairs on their way while the computer works on an earlier stop.
 
-The runner captures stop ``k`` and then, with the arm waiting at ``k``, measures stop ``k - 1``:
-a real head's pair is already there; the simulated head's snapshot (:mod:`cell.camera.workers`)
-is rendered in a worker process meanwhile, kept in the run directory and its markers detected
-there too, so that the cell computer's two cores render one stop and measure another. Each
-stop is still measured from its own pair, in the tour's order, so the results are those of one
-stop after another.
+The runner captures stop ``k`` and then, with the arm waiting at ``k``, measures stop
+``k - STOPS_AHEAD``: a real head's pairs are already there; the simulated head's snapshots
+(:mod:`cell.camera.workers`) are rendered in worker processes meanwhile, kept in the run
+directory and their markers detected there too, so that the cell computer's two cores render
+and measure at once. Each stop is still measured from its own pair, in the tour's order, so the
+results are those of one stop after another.
 """
 
 from __future__ import annotations
@@ -21,6 +21,11 @@ from cell.camera.workers import InProcess, PairSource, executor, pair_source, re
 from cell.referencing.detection import Detections, detect_pair
 from cell.review.audit_images import save_pair
 from measure import StereoCalibration
+
+#: the stops captured ahead of the one being measured: the arm waits at stop ``k`` while the
+#: computer measures stop ``k - STOPS_AHEAD`` and the workers render the ones between (a pair
+#: per core: the cell computer's two)
+STOPS_AHEAD = 2
 
 
 class PairsAhead:

@@ -4,6 +4,7 @@ thermal model identified from them (:class:`cell.run.runner.Runner`'s base)."""
 from __future__ import annotations
 
 import time
+from collections import deque
 from concurrent.futures import Future
 
 import numpy as np
@@ -13,6 +14,7 @@ from cell.camera.errors import PairError
 from cell.link import messages as m
 from cell.link.motion import Motion
 from cell.referencing.detection import detect_pair, label_circles
+from cell.run.ahead import STOPS_AHEAD
 from cell.run.reference import target_of
 from cell.run.thermal_record import remember_model
 from measure import MeasurementError, measure_hole
@@ -54,18 +56,15 @@ class ReferencePhase(Motion):
                 self.thermal.cold_degC = tuple(float(v) for v in st_start.temperatures_c)
                 self.store.set_thermal_reference(self.thermal.cold_degC)
             self.progress("round", {"round": rnd, "time_s": t_start})
-            pending = None  # the view captured, measured once the arm waits at the next one
+            pending: deque = deque()  # views captured, measured once the arm is further on
             for k, s in enumerate(tour.stops):
                 self._move(k, f"reference {s.hole_id}")
                 st = self._settled_status()
-                last, pending = (
-                    pending,
-                    (rnd, s.hole_id, st, self.ahead.capture(k, s.hole_id, keep=False)),
-                )
-                if last is not None:
-                    self._reference_view(*last)
-            if pending is not None:
-                self._reference_view(*pending)
+                pending.append((rnd, s.hole_id, st, self.ahead.capture(k, s.hole_id, keep=False)))
+                while len(pending) > STOPS_AHEAD:
+                    self._reference_view(*pending.popleft())
+            while pending:
+                self._reference_view(*pending.popleft())
             self._move(len(tour.stops), "reference home")
             if rnd + 1 < self.options.reference_rounds:
                 self._wait_controller_time(t_start + self.options.reference_interval_s)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import logging
 import sqlite3
 import time
+from collections import deque
 from collections.abc import Callable
 from concurrent.futures import Future
 from contextlib import closing
@@ -37,7 +38,7 @@ from cell.referencing.detection import detect_pair, label_circles
 from cell.referencing.network import MarkerNetwork
 from cell.review.audit_images import save_pair
 from cell.review.store import Store
-from cell.run.ahead import Laps, PairsAhead
+from cell.run.ahead import STOPS_AHEAD, Laps, PairsAhead
 from cell.run.inspect import T_cell_tcp, inspect_hole, uncaptured_hole
 from cell.run.reference_phase import ReferencePhase
 from cell.run.referenced import ArmRegistration, LocatedStop, locate_stop, located_note
@@ -204,24 +205,23 @@ class Runner(ReferencePhase):
         self.budget = self._budget_context()  # after the cold readings: no delay before them
         self._state("inspecting")
         self._load(self.tour)
-        pending = None  # the stop captured, measured once the arm waits at the next one
+        pending: deque = deque()  # stops captured, measured once the arm is STOPS_AHEAD on
         try:
             for k in todo:
-                last, pending = pending, self._capture_stop(k)
-                if last is not None:
-                    self._finish_stop(last, result)
-            if pending is not None:
-                pending, last = None, pending
-                self._finish_stop(last, result)
+                pending.append(self._capture_stop(k))
+                while len(pending) > STOPS_AHEAD:
+                    self._finish_stop(pending.popleft(), result)
+            while pending:
+                self._finish_stop(pending.popleft(), result)
         except KeyboardInterrupt:  # the operator stops the run now (a resume measures the rest)
             raise
         except BaseException:
-            if pending is not None:  # captured before the fault: measured and stored
+            while pending:  # captured before the fault: measured and stored
+                last = pending.popleft()
                 try:
-                    self._finish_stop(pending, result)
+                    self._finish_stop(last, result)
                 except Exception as exc:  # the fault is what the run reports
-                    log.error("stop %d could not be measured after the fault: %s",
-                              pending[0], exc)  # fmt: skip
+                    log.error("stop %d could not be measured after the fault: %s", last[0], exc)
             raise
         self._state("homing")
         self._move(len(self.tour.stops), "home")

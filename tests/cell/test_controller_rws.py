@@ -20,6 +20,7 @@ from cell.link.client import ControllerClient
 from cell.link.errors import RunFaultError
 from cell.rapid.module import link_module, link_settings
 from cell.review.store import Store
+from cell.run.ahead import STOPS_AHEAD
 from cell.run.runner import Runner, RunOptions
 from cell.run.setup import start_run
 from cell.sim.rapid_controller import RapidController
@@ -130,9 +131,10 @@ def test_a_run_watched_over_rws_stops_cleanly_when_the_motors_go_off(
             files.store.close()
     with Store.open(tmp_path) as store:
         info, n = store.run_info(), len(store.stored_ids())
-    # stop 0 is reported once the arm is at stop 1 and has captured it (cell.run.ahead): the
-    # motors go off then, the move to stop 2 fails, and both captured stops are stored
-    assert info["state"] == "fault" and n == 2
+    # stop 0 is reported once the arm is at stop STOPS_AHEAD and has captured it
+    # (cell.run.ahead): the motors go off then, the next move fails, and every captured stop is
+    # stored
+    assert info["state"] == "fault" and n == STOPS_AHEAD + 1
     msg = store_message(tmp_path)
     assert "motors off (controller state motoroff)" in msg and "motoroff, execution" in msg
 
