@@ -15,29 +15,19 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import platformdirs
-
+from measure.user_cache import cache_dir
 from planner.calibration import caltour_from_dict
 from planner.cell_identity import cell_sha256
 from planner.errors import PlanningError
 from planner.tour import write_json
 
-#: the environment variable that moves the cache folder (tests, shared machines)
-CACHE_ENV = "HOLECELL_CACHE_DIR"
 #: the packages (relative to the repository root) whose source decides the plan
 _CODE = ("planner", "robots", "cell/calibration/plan", "cell/demo", "cell/config")
-
-
-def cache_dir() -> Path:
-    """The folder of holecell's cached plans (``$HOLECELL_CACHE_DIR`` or the user's cache)."""
-    env = os.environ.get(CACHE_ENV)
-    return Path(env) if env else Path(platformdirs.user_cache_dir("holecell"))
 
 
 def _code_digest(packages: tuple[str, ...] = _CODE) -> str:

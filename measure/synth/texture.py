@@ -9,10 +9,13 @@ several times slower).
 
 from __future__ import annotations
 
+import inspect
 from functools import lru_cache
 
 import cv2
 import numpy as np
+
+from measure.synth.disk_cache import cached_array
 
 #: texel size of the surface texture (metres) and the tile side (texels)
 TEXEL_M = 50e-6
@@ -23,7 +26,13 @@ TILE_CENTER_M = 0.5 * TILE_TEXELS * TEXEL_M
 
 @lru_cache(maxsize=1)
 def texture_tile() -> np.ndarray:
-    """A 4096² float32 albedo tile, mean 0, std 1: milling marks, mottling and grain."""
+    """A 4096² float32 albedo tile, mean 0, std 1: milling marks, mottling and grain (drawn
+    once per machine, :mod:`measure.synth.disk_cache`; read-only)."""
+    return cached_array("texture", inspect.getsource(_draw_texture),
+                        (TILE_TEXELS, TILE_TEXELS), _draw_texture)  # fmt: skip
+
+
+def _draw_texture() -> np.ndarray:
     rng = np.random.default_rng(20260101)
     n = TILE_TEXELS
     coarse = rng.standard_normal((n // 16, n // 16)).astype(np.float32)
@@ -62,10 +71,17 @@ def sample_texture(tx: np.ndarray, ty: np.ndarray) -> np.ndarray:
     return out.reshape(shape)
 
 
+#: the noise bank's shape: the standard head's frame and 512 pixels of placements each way
+BANK_SHAPE = (2048 + 512, 2448 + 512)
+
+
 @lru_cache(maxsize=1)
 def _noise_bank() -> np.ndarray:
-    rng = np.random.default_rng(7)
-    return rng.standard_normal((2048 + 512, 2448 + 512), dtype=np.float32)
+    return cached_array("noise-bank", inspect.getsource(_draw_bank), BANK_SHAPE, _draw_bank)
+
+
+def _draw_bank() -> np.ndarray:
+    return np.random.default_rng(7).standard_normal(BANK_SHAPE, dtype=np.float32)
 
 
 def background_noise_at(

@@ -78,7 +78,7 @@ def link_for(controller: str, options):
 def private_cache(tmp_path_factory: pytest.TempPathFactory):
     """holecell's cache folder is a temporary one in these tests (the demo's calibration tour
     is planned once and read back as in use, but never from or into the user's cache)."""
-    from cell.demo.caltour_cache import CACHE_ENV
+    from measure.user_cache import CACHE_ENV
 
     before = os.environ.get(CACHE_ENV)
     os.environ[CACHE_ENV] = str(tmp_path_factory.mktemp("holecell-cache"))

@@ -10,7 +10,8 @@ import pytest
 from cell.calibration.plan import CalibrationPlanOptions, TargetGeometry, plan_calibration
 from cell.camera import cell_stereo
 from cell.config import load_builtin_cell
-from cell.demo.caltour_cache import CACHE_ENV, cache_dir, cached_caltour, caltour_key
+from cell.demo.caltour_cache import cached_caltour, caltour_key
+from measure.user_cache import CACHE_ENV, cache_dir
 from planner import Options
 from robots.transforms import make_transform, rpy_to_matrix
 
