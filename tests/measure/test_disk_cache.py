@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
 from measure.synth.disk_cache import cached_array
 from measure.user_cache import CACHE_ENV
 
