@@ -21,12 +21,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from concurrent.futures import Future
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from cell.calibration.capture.tour import CapturedTour, finish_calibration_tour
+from cell.calibration.capture.tour import CapturedTour, finish_calibration_tour, solve_captured
 from cell.calibration.estimate import CellCalibration, SolveOptions, pose_error, truth_in_gauge
 from cell.calibration.file import save_calibration
 from cell.calibration.use import RUN_FILENAME
@@ -171,6 +172,7 @@ class PendingCalibration:
     caltour: CalibrationTour
     run_dir: Path
     captured: CapturedTour
+    options: SolveOptions
     solve: Future
     progress: StageProgress | None
     captured_s: float  # the tour's wall time (s)
@@ -179,7 +181,11 @@ class PendingCalibration:
         """The adjustment's result (its refusals raised here), written to
         ``run_dir/cellcal.json`` and measured against the simulation's truth."""
         t0 = time.perf_counter()  # the solve's own time is in the summary, not in a bar
-        run = finish_calibration_tour(self.captured, self.solve.result())
+        try:
+            solved = self.solve.result()
+        except BrokenProcessPool:  # the worker died (memory?): solved here instead
+            solved = solve_captured(self.captured, self.options)
+        run = finish_calibration_tour(self.captured, solved)
         cal = run.result.calibration
         path = Path(self.run_dir) / RUN_FILENAME
         save_calibration(cal, path)
@@ -210,7 +216,6 @@ def start_demo_calibration_images(
         CalibrateCellOptions,
         CaptureSettings,
         capture_calibration_tour,
-        solve_captured,
     )
     from cell.link.client import ControllerClient
 
@@ -228,5 +233,5 @@ def start_demo_calibration_images(
     finally:
         sim.world.clock.set_speed(1.0)
     solve = executor(opts.capture.workers).submit(solve_captured, captured, opts.solve)
-    return PendingCalibration(sim, cell, caltour, run_dir, captured, solve, progress,
+    return PendingCalibration(sim, cell, caltour, run_dir, captured, opts.solve, solve, progress,
                               time.perf_counter() - t0)  # fmt: skip
