@@ -100,8 +100,12 @@ def main() -> None:
     ap.add_argument("--thermal-x", type=float, default=1.0, help="multiply the thermal drift")
     ap.add_argument("--calibration-method", default="projected", choices=("projected", "images"))
     ap.add_argument("--only", choices=("referenced", "robot"), default=None)
-    ap.add_argument("--sigma-floor-px", type=float, default=None,
-                    help="the simulated head's centre-noise floor (px; default the demo's)")
+    ap.add_argument(
+        "--sigma-floor-px",
+        type=float,
+        default=None,
+        help="the simulated head's centre-noise floor (px; default the demo's)",
+    )
     args = ap.parse_args()
     if args.sigma_floor_px is not None:
         demo_survey.SIM_SIGMA_FLOOR_PX = args.sigma_floor_px

@@ -207,7 +207,7 @@ def test_the_covariances_are_stated_at_the_a_posteriori_noise_above_the_floor(
     assert doc["figures"]["sigma_floor_px"] == SIGMA_FLOOR_PX
     doc["figures"]["sigma_effective_px"] = -1
     path.write_text(json.dumps(doc))
-    with pytest.raises(MarkersFileError, match="figures.sigma_effective_px"):
+    with pytest.raises(MarkersFileError, match=r"figures\.sigma_effective_px"):
         load_network(path, small_cell, stereo)
 
 

@@ -9,13 +9,13 @@ from dataclasses import dataclass
 from cell.camera import CameraBackend
 from cell.config import CellConfig
 from cell.link.client import ControllerClient
+from cell.referencing.sigma import SIGMA_FLOOR_PX
 from cell.referencing.survey.capture import (
     Progress,
     SurveyCapture,
     SurveyCaptures,
     SurveyCaptureSettings,
 )
-from cell.referencing.sigma import SIGMA_FLOOR_PX
 from cell.referencing.survey.result import SurveyResult
 from cell.referencing.survey.survey import SurveyOptions, survey
 from cell.referencing.survey.tour import SurveyTour
@@ -58,5 +58,7 @@ def run_survey(
     cap = SurveyCapture(cell, planned, client, camera, stereo,
                         SurveyCaptureSettings(settle_s=o.settle_s), progress).run()  # fmt: skip
     t = time.perf_counter()
-    result = survey(cell, stereo, cap.views, SurveyOptions(sigma_px=o.sigma_px, sigma_floor_px=o.sigma_floor_px))
+    result = survey(
+        cell, stereo, cap.views, SurveyOptions(sigma_px=o.sigma_px, sigma_floor_px=o.sigma_floor_px)
+    )
     return SurveyRun(planned, cap, result, time.perf_counter() - t)
