@@ -16,7 +16,9 @@ the covariances are stated at, ``sigma_eff_px``), the holes' position
 error against the truth in the datum frame A|B|C in the hole plane (RMS, worst), the truth
 within U, the position characteristics with U <= 1/4 of their zone, the median U, the stops
 referenced, the survey's robot time and adjustment time, the resection's time per stop
-(median), the demo's wall time.
+(median), the demo's wall time, and the median standard uncertainty of a referenced hole's
+position from the head's calibration, the survey's markers, the resection, the circle fit and
+the part's temperature (``u_*_um``).
 ``--arm-x`` and ``--thermal-x`` multiply the arm's repeatability and the thermal drift;
 ``--sigma-floor-px`` sets the simulated head's centre-noise floor (default: the demo's,
 :data:`cell.demo.survey.SIM_SIGMA_FLOOR_PX`; 0.02 is a real head's).
@@ -73,6 +75,11 @@ def _figures(res, run_dir: Path) -> dict:
         "referenced": sum(1 for x in refs if x and x.get("referenced")),
         "wall_s": res.timings["total_s"],
     }
+    holes = [h for h in doc.get("holes", []) if h.get("referenced")]
+    for key, col in U_PARTS.items():  # the budget's rows, median over the referenced holes
+        vals = [h.get(f"u_{key}_position_m") for h in holes]
+        vals = [v for v in vals if v is not None]
+        out[col] = 1e6 * float(np.median(vals)) if vals else float("nan")
     locate = [t.get("locate_s") for t in res.run.hole_timings if "locate_s" in t]
     out["locate_ms"] = 1e3 * float(np.median(locate)) if locate else float("nan")
     if res.survey is not None:
@@ -85,10 +92,18 @@ def _figures(res, run_dir: Path) -> dict:
     return out
 
 
+#: the budget rows printed (median standard uncertainty of a referenced hole's position, um)
+U_PARTS = {
+    "stereo_calibration": "u_head_um",
+    "survey_markers": "u_net_um",
+    "resection": "u_res_um",
+    "circle_fit": "u_fit_um",
+    "part_temperature": "u_temp_um",
+}
 COLS = ("seed", "path", "views", "survey_rms_um", "survey_max_um", "scale_ppm", "within_2s",
         "sigma_eff_px", "survey_robot_s", "survey_solve_s", "referenced", "holes_rms_um",
         "holes_max_um", "bestfit_rms_um", "within_U", "at_4to1", "n_pos", "U_median_um",
-        "locate_ms", "wall_s")  # fmt: skip
+        "locate_ms", "wall_s", *U_PARTS.values())  # fmt: skip
 
 
 def main() -> None:
