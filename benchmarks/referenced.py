@@ -17,6 +17,7 @@ within their stated 2 sigma; holes: datum-frame position error in the hole plane
 truth within U, the position characteristics with U <= 1/4 of their zone; times.
 
     python benchmarks/referenced.py [--seeds 10] [--large] [--sigma-px 0.05] [--arm-x 1]
+        [--sigma-floor-px 0.02]
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ from cell.gdt.truth_check import coverage, true_evaluation
 from cell.records.hole_result import HoleResult
 from cell.referencing.layout import stop_pose
 from cell.referencing.resection import resect
-from cell.referencing.sigma import effective_sigma_px
+from cell.referencing.sigma import SIGMA_FLOOR_PX
 from cell.referencing.survey.gauge import rigid_fit, to_gauge
 from cell.referencing.survey.plan import survey_views
 from cell.referencing.survey.problem import build_problem
@@ -92,7 +93,12 @@ def run_seed(seed: int, args, cell, stereo) -> dict:
         T_true = _perturbed(T_plan, rng, args.arm_mm * args.arm_x, args.arm_deg * args.arm_x)
         views.append(observe(mt, head, T_true, vid, args.sigma_px, rng, T_plan))
     t0 = time.perf_counter()
-    res = survey(cell, stereo, views, SurveyOptions(sigma_px=args.sigma_px))
+    res = survey(
+        cell,
+        stereo,
+        views,
+        SurveyOptions(sigma_px=args.sigma_px, sigma_floor_px=args.sigma_floor_px),
+    )
     t_survey = time.perf_counter() - t0
     out = {"seed": seed, "survey_s": t_survey, "views": res.n_views}
     # survey vs truth: the truth in the survey's gauge (its fixture markers fitted to nominal)
@@ -164,7 +170,7 @@ def _holes(seed, args, cell, stereo, world, head, mt, res, rng) -> dict:
             res.positions_cell,
             res.covariance,
             args.sigma_px,
-            effective_sigma_px(args.sigma_px, res.variance_factor),
+            res.sigma_effective_px,
         )
         t_res.append(time.perf_counter() - t0)
         if not r.ok:
@@ -265,6 +271,12 @@ def main() -> None:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--large", action="store_true", help="three times the realistic errors")
     ap.add_argument("--sigma-px", type=float, default=0.05, help="marker centre noise (px)")
+    ap.add_argument(
+        "--sigma-floor-px",
+        type=float,
+        default=SIGMA_FLOOR_PX,
+        help="the smallest centre noise the covariances are stated at (px)",
+    )
     ap.add_argument("--arm-mm", type=float, default=0.2, help="arm error of a view (mm, per axis)")
     ap.add_argument("--arm-deg", type=float, default=0.02, help="arm error of a view (deg)")
     ap.add_argument("--arm-x", type=float, default=1.0, help="multiply the arm's errors")

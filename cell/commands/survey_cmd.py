@@ -22,6 +22,7 @@ DESCRIPTION = (
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``survey`` to the top-level commands."""
     from cell.commands.argtypes import non_negative_float, output_file, positive_float
+    from cell.referencing.sigma import SIGMA_FLOOR_PX
 
     p = sub.add_parser("survey", help="survey the reference markers: markers.json",
                        description=DESCRIPTION)  # fmt: skip
@@ -47,7 +48,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--sigma-px",
         type=positive_float,
         default=0.05,
-        help="the markers' centre noise per image axis, px (%(default)s)",
+        help="the markers' stated centre noise per image axis, px (%(default)s): the first "
+        "adjustments' weights and the outlier limit",
+    )
+    p.add_argument(
+        "--sigma-floor-px",
+        type=non_negative_float,
+        default=SIGMA_FLOOR_PX,
+        help="the smallest centre noise the final adjustment weighs with and states the "
+        "covariances at, px (%(default)s: the best published target-centre accuracy)",
     )
     p.add_argument("--seed", type=int, default=0, help="seed of the tour's planning")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
@@ -97,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
         connect_checked(client, args.port, cell.robot.model)
         camera = open_camera(args.camera, stereo)
         done = run_survey(cell, planned, client, camera, stereo,
-                          SurveyRunOptions(args.settle_s, args.sigma_px),
+                          SurveyRunOptions(args.settle_s, args.sigma_px, args.sigma_floor_px),
                           _progress(args.quiet))  # fmt: skip
     finally:
         client.close()

@@ -15,6 +15,9 @@ def print_survey(done) -> None:
     print(f"  marker sigma: median {1e6 * float(np.median(np.linalg.norm(sigma, axis=1))):.1f} "
           f"um, largest {1e6 * float(np.linalg.norm(sigma, axis=1).max()):.1f} um; scale "
           f"{r.scale_sigma_ppm:.1f} ppm ({r.scale_source})")  # fmt: skip
+    post = r.sigma_px * float(np.sqrt(max(r.variance_factor, 0.0)))
+    print(f"  centre noise: {post:.4f} px a posteriori (stated {r.sigma_px:g} px); weighed and "
+          f"stated at {r.sigma_effective_px:.4f} px (floor {r.sigma_floor_px:g} px)")  # fmt: skip
     for w in r.warnings:
         print(f"  warning: {w}")
     if r.dropped_views:

@@ -16,7 +16,6 @@ from cell.config import CellConfig
 from cell.demo.caltour_cache import cached_plan, plan_key
 from cell.referencing import save_markers
 from cell.referencing.markersfile import MARKERS_FILENAME
-from cell.referencing.sigma import effective_sigma_px
 from cell.referencing.survey.gauge import rigid_fit
 from cell.referencing.survey.result import SurveyResult
 from cell.referencing.survey.run import SurveyRunOptions, run_survey
@@ -44,10 +43,12 @@ class DemoSurvey:
     #: the survey tour's planned robot time (s): motion and the 0.2 s settle per view; the
     #: simulator's clock (``robot_time_s``) also runs while each pair renders
     planned_robot_time_s: float = float("nan")
-    #: the share within 2 sigma with the covariance at the a posteriori centre noise, not
-    #: floored at :data:`cell.referencing.sigma.SIGMA_FLOOR_PX`: the model's own consistency
-    within_2sigma_posteriori: float = float("nan")
 
+
+#: the centre-noise floor of the simulated head (px): it states its own noise, the survey's a
+#: posteriori figure (0.006 px on the renderer's images), where a real head states
+#: :data:`cell.referencing.sigma.SIGMA_FLOOR_PX` (docs/referencing.md, "The floor")
+SIM_SIGMA_FLOOR_PX = 0.0
 
 #: the source that decides the survey tour (its cache key)
 SURVEY_PLAN_CODE = ("planner", "robots", "cell/referencing", "cell/demo", "cell/config")
@@ -117,7 +118,9 @@ def survey_demo_cell(
     try:
         with ControllerClient(sim.url) as client:
             done = run_survey(cell, planned, client, sim.camera, sim.camera.stereo,
-                              SurveyRunOptions(settle_s=0.2 / speed), _views(progress))  # fmt: skip
+                              SurveyRunOptions(settle_s=0.2 / speed,
+                                               sigma_floor_px=SIM_SIGMA_FLOOR_PX),
+                              _views(progress))  # fmt: skip
     finally:
         sim.world.clock.set_speed(1.0)
     path = Path(run_dir) / MARKERS_FILENAME
@@ -136,12 +139,7 @@ def survey_demo_cell(
     fixture = mt.on_fixture[rows] if r.gauge == "fixture markers" else np.ones(len(rows), bool)
     G = rigid_fit(true[fixture], mt.nominal[rows][fixture])
     z = np.abs(P - (true @ G[:3, :3].T + G[:3, 3])) / r.sigma_m()
-    # the same at the a posteriori centre noise, without the floor: is the model's sigma right
-    floor = effective_sigma_px(r.sigma_px, r.variance_factor) / (
-        r.sigma_px * np.sqrt(max(r.variance_factor, 1e-12))
-    )
     return DemoSurvey(path, r, time.perf_counter() - t0, done.captures.robot_time_s,
                       float(np.sqrt(np.mean(e**2))), float(e.max()), done.solve_s, float(scale),
                       float(np.mean(z < 2.0)), planned.plan_cache,
-                      float(planned.tour.cycle_time_s),
-                      float(np.mean(z * floor < 2.0)))  # fmt: skip
+                      float(planned.tour.cycle_time_s))  # fmt: skip

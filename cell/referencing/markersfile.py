@@ -28,7 +28,6 @@ import numpy as np
 from cell.calibration.file import fingerprint
 from cell.config import CellConfig
 from cell.referencing.errors import MarkersFileError
-from cell.referencing.sigma import effective_sigma_px
 from cell.referencing.survey.result import SurveyResult
 from measure import StereoCalibration
 from robots.files import write_text_atomic
@@ -77,7 +76,8 @@ def save_markers(
             "rms_px": result.rms_px,
             "variance_factor": result.variance_factor,
             "sigma_px": result.sigma_px,
-            "sigma_effective_px": effective_sigma_px(result.sigma_px, result.variance_factor),
+            "sigma_effective_px": result.sigma_effective_px,
+            "sigma_floor_px": result.sigma_floor_px,
             "views": result.n_views,
             "observations": result.n_observations,
         },

@@ -22,7 +22,12 @@ from cell.calibration.use import RunGeometry
 from cell.config import CellConfig, HoleInCell
 from cell.gdt.montecarlo import gdt_extra
 from cell.records.hole_result import HoleResult, deviations
-from cell.run.referenced import LocatedStop, referenced_contributions, survey_markers_factor
+from cell.run.referenced import (
+    HeadInputs,
+    LocatedStop,
+    referenced_contributions,
+    survey_markers_factor,
+)
 from cell.uncertainty.budget import combine
 from cell.uncertainty.context import BudgetContext, budget_context, hole_contributions
 from cell.uncertainty.decision import decide_hole, decide_one
@@ -116,9 +121,12 @@ def inspect_hole(
         result.diameter_m, cal_cov, cal_note)  # fmt: skip
     if referenced:
         rows = {c.name: c for c in contributions}
+        inliers = np.asarray(meas.points_m, float)[np.asarray(meas.inliers, bool)]
+        head = HeadInputs(stereo, ctx.calibration, inliers, located.resection_sigma_px)
         contributions = referenced_contributions(
             located, meas.center_m, T_part_cell[:3, :3], rows["circle_fit"],
-            rows["stereo_calibration"], rows["part_temperature"], network_source)  # fmt: skip
+            rows["stereo_calibration"], rows["part_temperature"], network_source,
+            head)  # fmt: skip
     delta = np.array(result.center_part_m) - nominal
     budget = combine(contributions, delta, normal_part, (ctx.part.note(),))
     extra = {**result.extra, **gdt_extra(contributions, T_part_left)}

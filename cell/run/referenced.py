@@ -10,9 +10,10 @@ fixture, a moved marker group, a wrong calibration). The markers are identified 
 not by the prior. With fewer than four usable markers the stop is
 not referenced and the run uses the arm, as without referencing, with its own (larger) budget.
 
-Budget of a referenced stop (part frame, m²): the circle fit, the head's calibration (as without
-referencing: a conservative bound, the survey self-calibrated the head), the resection's image
-noise, the survey's marker covariance carried through the resection, the part's temperature.
+Budget of a referenced stop (part frame, m²): the circle fit, the head's calibration through the
+hole and the markers of the same pair (the resected frame moves with the hole: most of it
+cancels, :mod:`cell.referencing.head_term`), the resection's image noise, the survey's marker
+covariance carried through the resection, the part's temperature.
 The arm's repeatability, kinematic calibration and thermal model are not in it: the arm only
 carried the head.
 """
@@ -27,10 +28,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.referencing.detection import Detections, observe_detections
+from cell.referencing.head_term import referenced_head_covariance, used_view
 from cell.referencing.network import MarkerNetwork
 from cell.referencing.observations import MarkerView
 from cell.referencing.resection import Resection, resect
 from cell.uncertainty.budget import Contribution
+from measure import StereoCalibration
+from measure.calibration_uncertainty import CalibrationUncertainty
 from robots.transforms import kabsch
 
 Array = NDArray[np.float64]
@@ -87,6 +91,18 @@ class ArmRegistration:
         return float(np.linalg.norm(P - self._points(T_cell_left_markers), axis=1).max())
 
 
+@dataclass(frozen=True)
+class HeadInputs:
+    """What the head's calibration row of a referenced stop needs: the head the hole was
+    measured with, its uncertainty, the hole's inlier edge points (left frame, m) and the
+    centre noise the resection weighs with (px)."""
+
+    stereo: StereoCalibration
+    uncertainty: CalibrationUncertainty
+    points_left_m: Array
+    sigma_px: float
+
+
 @dataclass(frozen=True, eq=False)
 class LocatedStop:
     """A stop's resection (``resection.ok`` False: not referenced, ``resection.reason`` why),
@@ -106,6 +122,12 @@ class LocatedStop:
     #: a stop that fell back: the arm's pose carried into the markers' frame (None: too few
     #: referenced stops before it to register the arm; the arm's own frame is used)
     T_cell_left_registered: Array | None = None
+    #: the network the stop was resected against: ids and positions (n, 3) m, cell frame (for
+    #: the head's calibration row, :func:`cell.referencing.head_term.referenced_head_covariance`)
+    marker_ids: tuple[str, ...] = ()
+    marker_positions: Array | None = None
+    #: the centre noise the resection weighed the markers with (px)
+    resection_sigma_px: float = 0.05
 
     @property
     def referenced(self) -> bool:
@@ -147,13 +169,23 @@ def locate_stop(
     view_id: str,
 ) -> LocatedStop:
     """Resect the head against the surveyed markers detected in the pair
-    (:func:`cell.referencing.detection.detect_pair`), about the arm's pose."""
+    (:func:`cell.referencing.detection.detect_pair`), about the arm's pose; then once more with
+    the markers' perspective bias removed at the resected pose, so that the result does not
+    depend on the arm's prior (a prior 1.7 mm and 0.09 deg off moved the bias by up to 0.0013 px
+    and the hole by up to 0.18 um; the arm's frame and the markers' differ by about 1 mm)."""
     geometry = {m: (network.positions_cell[k], network.normals_cell[k], float(network.radii_m[k]))
                 for k, m in enumerate(network.ids)}  # fmt: skip
+    args = (network.head, network.ids, network.positions_cell, network.covariance,
+            network.sigma_px, network.image_sigma_px)  # fmt: skip
     view = observe_detections(detections, network.head, network.codes, geometry, view_id,
                               T_cell_left_arm)  # fmt: skip
-    r = resect(view, network.head, network.ids, network.positions_cell, network.covariance,
-               network.sigma_px, network.image_sigma_px)  # fmt: skip
+    r = resect(view, *args)
+    if r.ok:
+        again = observe_detections(detections, network.head, network.codes, geometry, view_id,
+                                   r.T_cell_left)  # fmt: skip
+        r2 = resect(again, *args)
+        if r2.ok:
+            view, r = again, r2
     dt, dr = math.nan, math.nan
     if r.ok:
         D = np.linalg.inv(T_cell_left_arm) @ r.T_cell_left
@@ -164,7 +196,17 @@ def locate_stop(
         cols = np.asarray(r.marker_columns, np.int64)
         rows = (3 * cols[:, None] + np.arange(3)).ravel()
         factor = r.marker_sensitivity @ network.covariance_root[rows]
-    return LocatedStop(r, view, np.asarray(T_cell_left_arm, float), dt, dr, marker_factor=factor)
+    return LocatedStop(
+        r,
+        view,
+        np.asarray(T_cell_left_arm, float),
+        dt,
+        dr,
+        marker_factor=factor,
+        marker_ids=network.ids,
+        marker_positions=network.positions_cell,
+        resection_sigma_px=network.sigma_px,
+    )
 
 
 def survey_markers_factor(
@@ -187,10 +229,25 @@ def referenced_contributions(
     calibration: Contribution,
     temperature: Contribution,
     network_source: str,
+    head: HeadInputs | None = None,
 ) -> list[Contribution]:
-    """The budget rows of a referenced stop (module doc): the fit, the head's calibration and
-    the part temperature as given, the resection's image noise and the survey's markers."""
+    """The budget rows of a referenced stop (module doc): the fit and the part temperature as
+    given, the resection's image noise and the survey's markers; the head's calibration through
+    the hole and the markers of the same pair when ``head`` is given
+    (:func:`cell.referencing.head_term.referenced_head_covariance`), else ``calibration`` as
+    given (the head's error as if the arm had carried the camera frame: a bound)."""
     r = located.resection
+    if head is not None and located.marker_positions is not None:
+        cov = referenced_head_covariance(
+            head.stereo, head.uncertainty, used_view(located.view, r.used), located.marker_ids,
+            located.marker_positions, r.T_cell_left, head.points_left_m, head.sigma_px,
+        )  # fmt: skip
+        if cov is not None:
+            calibration = Contribution(
+                calibration.name, R_part_cell @ cov @ R_part_cell.T, calibration.var_diameter_m2,
+                f"{calibration.note}; through the hole and the {len(r.used)} markers of the "
+                "same pair",
+            )  # fmt: skip
     J = R_part_cell @ r.point_jacobian(center_left_m)
     cov_m = r.covariance_markers if r.covariance_markers is not None else np.zeros((6, 6))
     image = Contribution(

@@ -195,13 +195,50 @@ def test_the_covariances_are_stated_at_the_a_posteriori_noise_above_the_floor(
 
     assert effective_sigma_px(0.05, (0.006 / 0.05) ** 2) == SIGMA_FLOOR_PX  # a clean render
     assert np.isclose(effective_sigma_px(0.05, 4.0), 0.1)  # a detector worse than stated
+    assert np.isclose(effective_sigma_px(0.05, (0.006 / 0.05) ** 2, 0.0), 0.006)  # no floor
     _views, res = surveyed  # simulated at the stated 0.05 px: the variance factor is about 1
+    assert res.sigma_floor_px == SIGMA_FLOOR_PX  # a real head's floor by default
+    assert np.isclose(res.sigma_effective_px, 0.05 * np.sqrt(res.variance_factor), rtol=0.05)
     path = save_markers(tmp_path / "markers.json", res, small_cell, stereo)
     net = load_network(path, small_cell, stereo)
     assert net.sigma_px == 0.05
-    assert np.isclose(net.image_sigma_px, 0.05 * np.sqrt(res.variance_factor))
+    assert net.image_sigma_px == res.sigma_effective_px
     doc = json.loads(path.read_text())
+    assert doc["figures"]["sigma_floor_px"] == SIGMA_FLOOR_PX
     doc["figures"]["sigma_effective_px"] = -1
     path.write_text(json.dumps(doc))
-    with pytest.raises(MarkersFileError, match="figures.sigma_effective_px"):
+    with pytest.raises(MarkersFileError, match=r"figures\.sigma_effective_px"):
         load_network(path, small_cell, stereo)
+
+
+@pytest.fixture(scope="module")
+def clean(small_cell, stereo, marker_truth):
+    """The small cell surveyed on clean detections (0.006 px, the renderer's) with no floor."""
+    from cell.referencing.survey.survey import SurveyOptions
+
+    views = survey_observations(small_cell, stereo, marker_truth, seed=1, sigma_px=0.006)
+    return survey(small_cell, stereo, views, SurveyOptions(sigma_floor_px=0.0))
+
+
+def test_clean_images_are_weighed_at_their_own_noise_and_the_bars_keep_their_sigma(
+    surveyed, clean, small_cell, marker_truth
+):
+    """The final adjustment weighs the pixels at their a posteriori noise, the scale bars at
+    their own U: on images 8 times cleaner than stated the scale's sigma cannot go below what
+    the bars give, where scaling a covariance computed at the stated noise by the variance
+    factor (the old way) stated it at 0.12 of the 0.05 px figure, below the bars' own."""
+    _views, res = surveyed
+    assert 0.005 < clean.sigma_effective_px < 0.0075
+    assert 0.01 < clean.variance_factor < 0.025  # at the stated 0.05 px
+    bars_ppm = 1e6 / np.sqrt(sum((2 * b.length_m / b.U_m) ** 2 for b in small_cell.scale_bars))
+    assert clean.scale_sigma_ppm > 0.9 * bars_ppm
+    assert res.scale_sigma_ppm * np.sqrt(clean.variance_factor) < 0.9 * bars_ppm  # the old way
+    # the network's stated covariance against its true error (Mahalanobis, the gauge removed)
+    rows = [marker_truth.ids.index(m) for m in clean.marker_ids]
+    true, fx = marker_truth.true[rows], marker_truth.on_fixture[rows]
+    G = rigid_fit(true[fx], marker_truth.nominal[rows][fx])
+    e = (clean.positions_cell - (true @ G[:3, :3].T + G[:3, 3])).ravel()
+    w, V = np.linalg.eigh(clean.covariance)
+    k = w > w.max() * 1e-10
+    chi2_per_dof = float(np.sum((V[:, k].T @ e) ** 2 / w[k]) / k.sum())
+    assert 0.5 < chi2_per_dof < 1.6

@@ -19,9 +19,10 @@ class SurveyResult:
     frame, in the gauge ``gauge`` (``"fixture markers"`` or ``"all markers"``: a rigid fit to
     their nominal positions, ``gauge_residuals_m`` their distances after it).
 
-    ``rms_px``: the image residual RMS (ideal pixels), ``variance_factor`` chi2 / dof,
-    ``sigma_px`` the centre noise stated (the covariance is stated at the a posteriori noise,
-    not below a floor: :mod:`cell.referencing.sigma`); ``scale_sigma_ppm``: the network's scale
+    ``rms_px``: the image residual RMS (ideal pixels), ``variance_factor`` chi2 / dof at the
+    stated centre noise ``sigma_px``; ``sigma_effective_px``: the centre noise the final
+    adjustment weighed with and its covariance is stated at (the a posteriori noise, not below
+    ``sigma_floor_px``: :mod:`cell.referencing.sigma`); ``scale_sigma_ppm``: the network's scale
     uncertainty (from the scale bars and the head's baseline), ``scale_source`` says which;
     ``dropped_views``: views left out (too few markers, or on one line); ``outliers``: the
     observations dropped above the outlier limit, as ``(view, marker, camera, normalised
@@ -46,6 +47,8 @@ class SurveyResult:
     timings: dict[str, float] = field(default_factory=dict)
     sigma_px: float = 0.05
     stereo: StereoCalibration | None = None
+    sigma_effective_px: float = 0.05
+    sigma_floor_px: float = 0.02
 
     def sigma_m(self) -> Array:
         """Per-marker standard deviations (n, 3) m along the cell axes."""

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from cell.camera import CameraBackend
 from cell.config import CellConfig
 from cell.link.client import ControllerClient
+from cell.referencing.sigma import SIGMA_FLOOR_PX
 from cell.referencing.survey.capture import (
     Progress,
     SurveyCapture,
@@ -23,10 +24,13 @@ from measure import StereoCalibration
 
 @dataclass(frozen=True)
 class SurveyRunOptions:
-    """Wait after "in position" (s) and the markers' centre noise per image axis (px)."""
+    """Wait after "in position" (s), the markers' stated centre noise per image axis (px) and
+    the floor of the centre noise the covariances are stated at (px,
+    :mod:`cell.referencing.sigma`)."""
 
     settle_s: float = 0.2
     sigma_px: float = 0.05
+    sigma_floor_px: float = SIGMA_FLOOR_PX
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,5 +58,7 @@ def run_survey(
     cap = SurveyCapture(cell, planned, client, camera, stereo,
                         SurveyCaptureSettings(settle_s=o.settle_s), progress).run()  # fmt: skip
     t = time.perf_counter()
-    result = survey(cell, stereo, cap.views, SurveyOptions(sigma_px=o.sigma_px))
+    result = survey(
+        cell, stereo, cap.views, SurveyOptions(sigma_px=o.sigma_px, sigma_floor_px=o.sigma_floor_px)
+    )
     return SurveyRun(planned, cap, result, time.perf_counter() - t)

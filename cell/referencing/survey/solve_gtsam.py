@@ -26,7 +26,6 @@ from gtsam.symbol_shorthand import C, L, R, X, Y
 from scipy.linalg import cho_factor, cho_solve
 
 from cell.referencing.errors import SurveyRefusedError
-from cell.referencing.sigma import covariance_scale
 from cell.referencing.survey.problem import Array, SurveyProblem
 from cell.referencing.survey.solution import RawSolution
 
@@ -130,8 +129,10 @@ def solve_gtsam(
     problem: SurveyProblem, covariance: bool = True, robust: bool = False
 ) -> RawSolution:
     """Adjust ``problem`` (module doc); ``covariance``: also the markers' joint covariance
-    (3n, 3n) m² and the head's, stated at the a posteriori centre noise, not below the floor
-    (:mod:`cell.referencing.sigma`); ``robust``: the image residuals through a Huber loss
+    (3n, 3n) m² and the head's, at the problem's ``sigma_px`` (the caller weighs with the
+    a posteriori centre noise, :mod:`cell.referencing.sigma`), inflated by the variance factor
+    when it is above 1, never deflated (that would scale the scale bars' and the priors'
+    information with the pixels'); ``robust``: the image residuals through a Huber loss
     (:data:`HUBER_K` sigma), so that a gross error (a misread marker, a view far off its
     plan) cannot pull the self-calibrated head with it before it is found."""
     graph, values = _graph(problem, robust=robust)
@@ -159,7 +160,7 @@ def solve_gtsam(
     chi2 = 2.0 * graph.error(result)
     cov, head_cov = None, None
     if covariance:
-        scale = covariance_scale(problem.sigma_px, chi2 / dof)
+        scale = max(chi2 / dof, 1.0)
         cov, head_cov = _covariances(problem, graph, result)
         cov, head_cov = cov * scale, tuple(c * scale for c in head_cov)
     return RawSolution(points, poses, cov, chi2, dof, int(opt.iterations()), head, head_cov)

@@ -10,7 +10,7 @@ has any, else from the head's baseline alone (about 100 ppm, said in a warning).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -18,6 +18,7 @@ from cell.config import CellConfig
 from cell.config.markers import marker_in_cell
 from cell.referencing.errors import SurveyRefusedError
 from cell.referencing.observations import MarkerView
+from cell.referencing.sigma import SIGMA_FLOOR_PX, effective_sigma_px
 from cell.referencing.survey.gauge import to_gauge
 from cell.referencing.survey.problem import Array, Head, SurveyProblem, build_problem, predict
 from cell.referencing.survey.refusals import check_network, usable_views
@@ -38,11 +39,15 @@ BASELINE_SCALE_PPM = 100.0
 
 @dataclass(frozen=True)
 class SurveyOptions:
-    """``sigma_px``: the marker centres' standard deviation (px), from the marker benchmark
-    (docs/referencing.md); ``max_outlier_rounds``: re-adjustments after dropping outliers."""
+    """``sigma_px``: the marker centres' stated standard deviation (px), from the marker
+    benchmark (docs/referencing.md): the first adjustments' weights and the outlier limit;
+    ``sigma_floor_px``: the smallest centre noise the final adjustment weighs with and states
+    its covariance at (:mod:`cell.referencing.sigma`: a real head's floor by default);
+    ``max_outlier_rounds``: re-adjustments after dropping outliers."""
 
     sigma_px: float = 0.05
     max_outlier_rounds: int = 3
+    sigma_floor_px: float = SIGMA_FLOOR_PX
 
 
 def survey(
@@ -90,8 +95,12 @@ def survey(
             )
         problem = problem.without(~bad)
         _check_still(problem, kept, ids, nominal)
+    # variance component: the image observations weighed at their own a posteriori noise (not
+    # below the floor) in the final adjustment; the bars and the head's priors keep theirs
+    vf = float(np.sum(_normalised(problem, raw) ** 2) * 2.0 / raw.dof)
+    sigma_w = effective_sigma_px(o.sigma_px, vf, o.sigma_floor_px)
     t1 = time.perf_counter()
-    raw = solve_gtsam(problem, covariance=True)
+    raw = solve_gtsam(replace(problem, sigma_px=sigma_w), covariance=True)
     t2 = time.perf_counter()
     g = to_gauge(raw.points, raw.covariance, nominal, fixture)
     assert g.covariance is not None
@@ -109,8 +118,10 @@ def survey(
         gauge=g.kind,
         gauge_residuals_m=g.residuals_m,
         rms_px=float(np.sqrt(np.mean(res**2))),
-        variance_factor=raw.variance_factor,
+        variance_factor=vf,
         sigma_px=o.sigma_px,
+        sigma_effective_px=sigma_w * float(np.sqrt(max(raw.variance_factor, 1.0))),
+        sigma_floor_px=o.sigma_floor_px,
         n_views=problem.n_views,
         n_observations=len(problem.uv),
         scale_sigma_ppm=scale_ppm,
