@@ -13,8 +13,9 @@ for the others, demo seed 1) while the truth fell within U for every characteris
 :func:`referenced_head_covariance` propagates each of the 24 parameters (``+-1 sigma``, central
 differences, as :func:`~cell.uncertainty.calibration.jacobian_covariance`) through both: the
 hole's edge points re-triangulated and its circle refitted in the changed head, the stop
-resected again from the same marker pixels with the changed head, and the centre carried into
-the cell. The parameters are taken as independent, as the head's file states them.
+resected again from the same marker pixels with the changed head (to first order: one
+Gauss-Newton step, :func:`cell.referencing.resection.pose_sensitivity`), and the centre carried
+into the cell. The parameters are taken as independent, as the head's file states them.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cell.referencing.observations import MarkerView
-from cell.referencing.resection import resect
+from cell.referencing.resection import pose_sensitivity
 from cell.uncertainty.calibration import (
     MAX_JACOBIAN_POINTS,
     N_PARAMETERS,
@@ -52,24 +53,26 @@ def referenced_head_covariance(
     """The covariance (3, 3) m², cell frame, of a referenced hole's centre from the head's
     calibration uncertainty ``unc`` (module doc). ``view``: the stop's markers (only those the
     resection used); ``T_cell_left``: its resected pose; ``points_left_m``: the hole's inlier
-    edge points (left frame, m). None when a changed head no longer resects the stop."""
+    edge points (left frame, m)."""
     pts = np.asarray(points_left_m, float)
     if len(pts) > MAX_JACOBIAN_POINTS:
         pts = pts[np.linspace(0, len(pts) - 1, MAX_JACOBIAN_POINTS).round().astype(int)]
     px_l, px_r = pixel_pairs(stereo, pts)
-    start = MarkerView(view.view_id, view.uv_left, view.uv_right, np.asarray(T_cell_left, float))
     sig = parameter_sigmas(unc)
-    cols = []
-    for i in np.flatnonzero(sig > 0):
+    free = np.flatnonzero(sig > 0)
+    heads = [stereo]
+    for i in free:
         e = np.zeros(N_PARAMETERS)
         e[i] = sig[i]
+        heads += [perturbed(stereo, e), perturbed(stereo, -e)]
+    poses = pose_sensitivity(view, marker_ids, positions_cell, T_cell_left, heads)
+    cols = []
+    for k in range(len(free)):
         ends = []
-        for head in (perturbed(stereo, e), perturbed(stereo, -e)):
+        for head, T in zip(heads[1 + 2 * k : 3 + 2 * k], poses[1 + 2 * k : 3 + 2 * k],
+                           strict=True):  # fmt: skip
             c = algebraic_circle(retriangulate(head, px_l, px_r))[:3]
-            r = resect(start, head, marker_ids, positions_cell, None, sigma_px)
-            if not r.ok:
-                return None
-            ends.append(r.T_cell_left[:3, :3] @ c + r.T_cell_left[:3, 3])
+            ends.append(T[:3, :3] @ c + T[:3, 3])
         cols.append(0.5 * (ends[0] - ends[1]))
     if not cols:
         return np.zeros((3, 3))

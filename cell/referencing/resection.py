@@ -186,3 +186,31 @@ def _marker_jacobian(x: Array, args: tuple) -> Array:
             j = obs.marker[row]
             J[2 * row : 2 * row + 2, 3 * j : 3 * j + 3] = G[q]
     return J
+
+
+def pose_sensitivity(
+    view: MarkerView,
+    marker_ids: tuple[str, ...],
+    positions: Array,
+    T_cell_left: Array,
+    heads: list[StereoCalibration],
+) -> list[Array]:
+    """The pose a resection of ``view`` (the markers ``marker_ids`` at ``positions``, every one
+    used) gives with each head of ``heads`` (the first: the head ``T_cell_left`` was resected
+    with), to first order: one Gauss-Newton step from ``T_cell_left`` with the first head's
+    Jacobian (forward differences of the pose's six increments). For a head's small changes
+    (a calibration's sigma) this is the full resection's change to second order, at the cost of
+    one evaluation of the residuals per head instead of a solve."""
+    index = {m: k for k, m in enumerate(marker_ids)}
+    T0 = np.asarray(T_cell_left, float)
+
+    def residuals(head: StereoCalibration, x: Array) -> Array:
+        obs = _Obs(view, head, index)
+        K = (np.asarray(head.K_left, float), np.asarray(head.K_right, float))
+        return _residuals(x, T0, obs, positions, K, T_left_right(head), 1.0)
+
+    r0 = residuals(heads[0], np.zeros(6))
+    h = 1e-7
+    J = np.column_stack([(residuals(heads[0], h * e) - r0) / h for e in np.eye(6)])
+    step = np.linalg.pinv(J)
+    return [_pose(T0, -step @ residuals(head, np.zeros(6))) for head in heads]
