@@ -192,6 +192,7 @@ def format_demo(res: DemoResult) -> str:
         ("worst position", f"⌀{worst * 1e3:.4f} mm (ISO 1101; hole {s['worst_hole']}, "
                            f"{s['worst_position_frame']} frame)" if worst else "-"),
         ("cycle time (planned)", f"{res.tour.cycle_time_s:.1f} s"),
+        ("  hole tour", str(res.tour.settings.get("plan_cache", "")) or "-"),
         ("position error vs truth", _datum(dt)),
         ("  best fit", _best_fit(dt)),
         ("  in the fixture frame", f"{tr.rms_in_plane_m * 1e6:.1f} um RMS in the hole plane "

@@ -1,9 +1,9 @@
 """The demo's tours: the holes', the reference targets', the calibration's and the survey's.
 
-The hole tour is planned in this process every time (it is what the demo shows). The other three
-are deterministic per cell, seed and code: each is read from the user's cache folder
-(:mod:`cell.demo.caltour_cache`) when it is there, and otherwise planned in a worker process
-while this one plans the holes (and cached).
+All four are deterministic per cell, seed and code: each is read from the user's cache folder
+(:mod:`cell.demo.caltour_cache`) when it is there. Otherwise the hole tour is planned in this
+process, with the planner's progress (the first run shows the planning), and the other three
+in worker processes meanwhile; all are cached.
 """
 
 from __future__ import annotations
@@ -27,6 +27,9 @@ from planner.calibration import CalibrationTour, caltour_from_dict
 from planner.cell_identity import cell_sha256
 from planner.tour import tour_from_dict
 
+#: the source that decides the hole tour (its cache key)
+HOLE_PLAN_CODE = ("planner", "robots", "cell/referencing", "cell/camera", "cell/demo",
+                  "cell/config")  # fmt: skip
 #: the source that decides the reference tour (its cache key)
 REFERENCE_PLAN_CODE = ("planner", "robots", "cell/run", "cell/demo", "cell/config")
 
@@ -46,6 +49,32 @@ def plan_demo_reference(seed: int, cached_only: bool = False) -> dict[str, Any] 
                    REFERENCE_PLAN_CODE)  # fmt: skip
     found = cached_plan("reference", key, None if cached_only else plan, tour_from_dict)
     return None if found is None else found[0]
+
+
+def _hole_tour(
+    cell: CellConfig, seed: int, markers: bool,
+    plan_progress: Callable[[str, int, int], None] | None,
+) -> Tour:  # fmt: skip
+    """The hole tour (``markers``: the viewpoints chosen to see the markers), planned here with
+    the planner's progress the first time, then read from the user's cache folder; its
+    ``settings["plan_cache"]`` says which."""
+
+    def plan() -> dict[str, Any]:
+        planner = (
+            MarkerAwarePlanner(cell, cell_stereo(cell), Options(seed=seed), plan_progress)
+            if markers
+            else TourPlanner(Options(seed=seed), plan_progress)
+        )
+        return planner.plan(cell).to_dict()
+
+    key = plan_key({"plan": "holes", "cell": cell_sha256(cell), "seed": seed,
+                    "markers": markers}, HOLE_PLAN_CODE)  # fmt: skip
+    found = cached_plan("holes", key, plan, tour_from_dict)
+    assert found is not None  # planned when missing
+    data, note = found
+    tour = tour_from_dict(data, "hole tour")
+    tour.settings["plan_cache"] = note
+    return tour
 
 
 def plan_demo(
@@ -78,11 +107,7 @@ def plan_demo(
             name: pool.submit(jobs[name][0], *jobs[name][1])
             for name in misses  # type: ignore[union-attr]
         }
-        tour = (
-            MarkerAwarePlanner(cell, cell_stereo(cell), Options(seed=seed), plan_progress)
-            if survey
-            else TourPlanner(Options(seed=seed), plan_progress)
-        ).plan(cell)
+        tour = _hole_tour(cell, seed, survey, plan_progress)
         if "caltour" in futures and plan_progress is not None:  # may still be planning
             plan_progress("calibration tour", int(futures["caltour"].done()), 1)
         done = {**found, **{name: f.result() for name, f in futures.items()}}
