@@ -36,15 +36,14 @@ def cached_array(
         "\n".join((source, np.__version__, cv2.__version__, repr(shape))).encode()
     ).hexdigest()[:24]
     path = cache_dir() / f"{name}-{digest}.npy"
-    try:
-        arr = np.load(path, mmap_mode="r")
-        if arr.shape == shape and arr.dtype == np.float32:
-            return arr
-        log.warning("%s: shape %s, dtype %s: drawn again", path, arr.shape, arr.dtype)
-    except FileNotFoundError:
-        pass
-    except (OSError, ValueError) as exc:
-        log.warning("%s: unreadable (%s): drawn again", path, exc)
+    if path.is_file():
+        try:
+            arr = np.load(path, mmap_mode="r")
+            if arr.shape == shape and arr.dtype == np.float32:
+                return arr
+            log.warning("%s: shape %s, dtype %s: drawn again", path, arr.shape, arr.dtype)
+        except (OSError, ValueError) as exc:
+            log.warning("%s: unreadable (%s): drawn again", path, exc)
     arr = draw()
     _write(path, arr)
     arr.setflags(write=False)
