@@ -20,7 +20,7 @@ from scipy.optimize import least_squares
 
 from cell.referencing.observations import MarkerView, T_left_right, ideal_pixels
 from measure import StereoCalibration
-from robots.transforms import invert, skew, so3_exp
+from robots.transforms import invert, skew, so3_exp, so3_left_jacobian
 
 Array = NDArray[np.float64]
 
@@ -114,6 +114,44 @@ def _residuals(
     return (out / sigma).ravel()
 
 
+def _pose_jacobian(
+    x: Array, T0: Array, obs: _Obs, P: Array, K: tuple[Array, Array], T_lr: Array, sigma: float
+) -> Array:
+    """d :func:`_residuals` / d x (k, 6), analytic. With ``R = R0 exp(w)``, a change ``d`` of
+    ``w`` turns ``R`` by ``phi = J_r(w) d`` on the right; the left camera's point
+    ``p = R^T (P - t)`` moves by ``[p]x phi``, the right camera's ``R_lr^T (q + [q]x phi) -
+    R_lr^T t_lr`` (``q = R^T (P - t)``) by ``R_lr^T [q]x phi``; a change of ``t`` moves either by
+    ``-R_cam^T``; then ``d uv / d p`` as in :func:`_marker_jacobian`."""
+    T = _pose(T0, x)
+    R, t = T[:3, :3], T[:3, 3]
+    Jr = so3_left_jacobian(-np.asarray(x[:3], float))
+    R_lr = T_lr[:3, :3]
+    J = np.zeros((2 * len(obs.uv), 6))
+    for s in (0, 1):
+        rows = np.flatnonzero(obs.side == s)
+        if len(rows) == 0:
+            continue
+        q = (P[obs.marker[rows]] - t) @ R  # R^T (P - t), per row
+        if s == 0:
+            pc, A, dt = q, np.eye(3), -R.T
+        else:
+            pc, A = q @ R_lr - T_lr[:3, 3] @ R_lr, R_lr.T
+            dt = -(R @ R_lr).T
+        z = pc[:, 2]
+        D = np.zeros((len(rows), 2, 3))
+        D[:, 0, 0] = D[:, 1, 1] = 1.0 / z
+        D[:, 0, 2], D[:, 1, 2] = -pc[:, 0] / z**2, -pc[:, 1] / z**2
+        KD = np.einsum("ab,kbc->kac", K[s][:2, :2], D) / sigma  # (k, 2, 3)
+        skews = np.zeros((len(rows), 3, 3))
+        skews[:, 0, 1], skews[:, 0, 2], skews[:, 1, 2] = -q[:, 2], q[:, 1], -q[:, 0]
+        skews[:, 1, 0], skews[:, 2, 0], skews[:, 2, 1] = q[:, 2], -q[:, 1], q[:, 0]
+        Jw = np.einsum("kac,cd,kde,ef->kaf", KD, A, skews, Jr)
+        Jt = np.einsum("kac,cd->kad", KD, dt)
+        J[2 * rows] = np.hstack([Jw[:, 0], Jt[:, 0]])
+        J[2 * rows + 1] = np.hstack([Jw[:, 1], Jt[:, 1]])
+    return J
+
+
 def resect(
     view: MarkerView,
     stereo: StereoCalibration,
@@ -138,7 +176,8 @@ def resect(
             why = f"{len(used)} usable markers, {MIN_MARKERS} needed"
             return Resection(False, T0, np.full((6, 6), np.nan), tuple(used), refused, reason=why)
         args = (T0, obs, positions, K, T_lr, sigma_px)
-        sol = least_squares(_residuals, np.zeros(6), args=args, method="lm", xtol=1e-14, ftol=1e-14)
+        sol = least_squares(_residuals, np.zeros(6), jac=_pose_jacobian, args=args, method="lm",
+                            xtol=1e-14, ftol=1e-14)  # fmt: skip
         r = sol.fun.reshape(-1, 2)
         per = np.linalg.norm(r, axis=1) / np.sqrt(2.0)
         worst = int(np.argmax(per))

@@ -82,3 +82,20 @@ def test_the_marker_jacobian_matches_finite_differences(small_cell, stereo, mark
             num = (rs._residuals(x, *args[:2], Pp, *args[3:])
                    - rs._residuals(x, *args[:2], Pm, *args[3:])) / (2 * h)  # fmt: skip
             np.testing.assert_allclose(J[:, 3 * j + a], num, atol=1e-6 * np.abs(num).max())
+
+
+def test_the_pose_jacobian_matches_finite_differences(small_cell, stereo, marker_truth):
+    from cell.referencing import resection as rs
+
+    _T, view = _stop(small_cell, stereo, marker_truth)
+    obs = rs._Obs(view, stereo, {m: k for k, m in enumerate(marker_truth.ids)})
+    K = (np.asarray(stereo.K_left), np.asarray(stereo.K_right))
+    args = (view.T_cell_left_prior, obs, marker_truth.true, K, rs.T_left_right(stereo), 0.05)
+    assert set(obs.side) == {0, 1}  # both cameras' rows
+    for x in (np.zeros(6), np.array([2e-2, -3e-2, 1e-2, 1e-3, 0.0, -2e-3])):
+        J = rs._pose_jacobian(x, *args)
+        h = 1e-7
+        for a in range(6):
+            e = np.eye(6)[a] * h
+            num = (rs._residuals(x + e, *args) - rs._residuals(x - e, *args)) / (2 * h)
+            np.testing.assert_allclose(J[:, a], num, atol=1e-5 * np.abs(num).max())
