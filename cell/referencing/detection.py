@@ -17,7 +17,12 @@ from numpy.typing import NDArray
 
 from cell.referencing.observations import MarkerView, T_left_right, ideal_pixels
 from measure import StereoCalibration
-from measure.markers import DEFAULT_DESIGN, MarkerDetection, circle_center_bias_px, detect_markers
+from measure.markers import (
+    DEFAULT_DESIGN,
+    MarkerDetection,
+    circle_center_bias_many_px,
+    detect_markers,
+)
 from robots.transforms import invert
 
 Array = NDArray[np.float64]
@@ -103,16 +108,18 @@ def observe_detections(
     for side, dets in zip(("left", "right"), detections, strict=True):
         K, _ = _camera(stereo, side)
         T_cam_cell = invert(cams[side])
-        seen: dict[str, Array] = {}
-        for det in dets:
-            mid = codes[det.code]
-            uv = ideal_pixels(stereo, side, np.asarray(det.center_px, float)[None])[0]
-            if mid in geometry:
-                p, n, r = geometry[mid]
-                c_cam = T_cam_cell[:3, :3] @ p + T_cam_cell[:3, 3]
-                n_cam = T_cam_cell[:3, :3] @ n
-                if c_cam[2] > 0:
-                    uv = uv - circle_center_bias_px(K, c_cam, n_cam, r)
-            seen[mid] = distorted_pixels(stereo, side, uv[None])[0]
-        found.append(seen)
+        ids = [codes[det.code] for det in dets]
+        uv = ideal_pixels(stereo, side, np.array([det.center_px for det in dets], float))
+        known = [k for k, mid in enumerate(ids) if mid in geometry]
+        if known:
+            p = np.array([geometry[ids[k]][0] for k in known], float)
+            n = np.array([geometry[ids[k]][1] for k in known], float)
+            r = np.array([geometry[ids[k]][2] for k in known], float)
+            c_cam = p @ T_cam_cell[:3, :3].T + T_cam_cell[:3, 3]
+            front = c_cam[:, 2] > 0
+            rows = np.asarray(known)[front]
+            uv[rows] -= circle_center_bias_many_px(
+                K, c_cam[front], n[front] @ T_cam_cell[:3, :3].T, r[front]
+            )
+        found.append(dict(zip(ids, distorted_pixels(stereo, side, uv), strict=True)))
     return MarkerView(view_id, found[0], found[1], T_prior)

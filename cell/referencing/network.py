@@ -49,6 +49,13 @@ class MarkerNetwork:
         return self.ids.index(marker_id)
 
     @cached_property
+    def geometry(self) -> dict[str, tuple[Array, Array, float]]:
+        """Each marker's centre (3,) and unit normal (3,) in the cell frame and its dot's
+        radius (m), by id (:data:`cell.referencing.detection.MarkerGeometry`)."""
+        return {m: (self.positions_cell[k], self.normals_cell[k], float(self.radii_m[k]))
+                for k, m in enumerate(self.ids)}  # fmt: skip
+
+    @cached_property
     def covariance_root(self) -> Array:
         """``L`` (3n, 3n) m with ``L L^T = covariance``: the network's error is ``L z``,
         ``z ~ N(0, I)`` (symmetric eigen-decomposition; negative rounding clipped)."""

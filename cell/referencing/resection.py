@@ -28,6 +28,9 @@ Array = NDArray[np.float64]
 MIN_MARKERS = 4
 #: a marker this many sigma off the others is refused
 OUTLIER_SIGMA = 5.0
+#: Levenberg-Marquardt's stops: the relative change of the cost, and of the step against the
+#: increment about the prior (about 1e-3 from the arm: 1e-13 m and rad, far below any figure)
+FTOL, XTOL = 1e-10, 1e-10
 
 
 @dataclass(frozen=True)
@@ -141,12 +144,12 @@ def _pose_jacobian(
         D = np.zeros((len(rows), 2, 3))
         D[:, 0, 0] = D[:, 1, 1] = 1.0 / z
         D[:, 0, 2], D[:, 1, 2] = -pc[:, 0] / z**2, -pc[:, 1] / z**2
-        KD = np.einsum("ab,kbc->kac", K[s][:2, :2], D) / sigma  # (k, 2, 3)
+        KD = (K[s][:2, :2] / sigma) @ D  # (k, 2, 3)
         skews = np.zeros((len(rows), 3, 3))
         skews[:, 0, 1], skews[:, 0, 2], skews[:, 1, 2] = -q[:, 2], q[:, 1], -q[:, 0]
         skews[:, 1, 0], skews[:, 2, 0], skews[:, 2, 1] = q[:, 2], -q[:, 1], q[:, 0]
-        Jw = np.einsum("kac,cd,kde,ef->kaf", KD, A, skews, Jr)
-        Jt = np.einsum("kac,cd->kad", KD, dt)
+        Jw = (KD @ A) @ skews @ Jr
+        Jt = KD @ dt
         J[2 * rows] = np.hstack([Jw[:, 0], Jt[:, 0]])
         J[2 * rows + 1] = np.hstack([Jw[:, 1], Jt[:, 1]])
     return J
@@ -177,7 +180,7 @@ def resect(
             return Resection(False, T0, np.full((6, 6), np.nan), tuple(used), refused, reason=why)
         args = (T0, obs, positions, K, T_lr, sigma_px)
         sol = least_squares(_residuals, np.zeros(6), jac=_pose_jacobian, args=args, method="lm",
-                            xtol=1e-14, ftol=1e-14)  # fmt: skip
+                            xtol=XTOL, ftol=FTOL)  # fmt: skip
         r = sol.fun.reshape(-1, 2)
         per = np.linalg.norm(r, axis=1) / np.sqrt(2.0)
         worst = int(np.argmax(per))

@@ -21,7 +21,7 @@ carried the head.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -173,19 +173,17 @@ def locate_stop(
     the markers' perspective bias removed at the resected pose, so that the result does not
     depend on the arm's prior (a prior 1.7 mm and 0.09 deg off moved the bias by up to 0.0013 px
     and the hole by up to 0.18 um; the arm's frame and the markers' differ by about 1 mm)."""
-    geometry = {m: (network.positions_cell[k], network.normals_cell[k], float(network.radii_m[k]))
-                for k, m in enumerate(network.ids)}  # fmt: skip
-    args = (network.head, network.ids, network.positions_cell, network.covariance,
-            network.sigma_px, network.image_sigma_px)  # fmt: skip
-    view = observe_detections(detections, network.head, network.codes, geometry, view_id,
-                              T_cell_left_arm)  # fmt: skip
-    r = resect(view, *args)
+    args = (network.head, network.ids, network.positions_cell)
+    noise = (network.sigma_px, network.image_sigma_px)
+    view = observe_detections(detections, network.head, network.codes, network.geometry,
+                              view_id, T_cell_left_arm)  # fmt: skip
+    r = resect(view, *args, None, *noise)  # the pose only: no marker covariance
     if r.ok:
-        again = observe_detections(detections, network.head, network.codes, geometry, view_id,
-                                   r.T_cell_left)  # fmt: skip
-        r2 = resect(again, *args)
-        if r2.ok:
-            view, r = again, r2
+        again = observe_detections(detections, network.head, network.codes, network.geometry,
+                                   view_id, r.T_cell_left)  # fmt: skip
+        # the first pass's refusals kept; this pass decides (its outlier test included)
+        r2 = resect(used_view(again, r.used), *args, network.covariance, *noise)
+        view, r = again, replace(r2, refused={**r.refused, **r2.refused})
     dt, dr = math.nan, math.nan
     if r.ok:
         D = np.linalg.inv(T_cell_left_arm) @ r.T_cell_left

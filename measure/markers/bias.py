@@ -6,6 +6,12 @@ conic ``diag(1, 1, -r²)`` of the plane coordinates; the pinhole maps the plane 
 the homography ``H = K [e1 e2 C]``, so the image is the conic ``A = H⁻ᵀ diag(1, 1, -r²) H⁻¹``,
 whose centre solves ``A[:2, :2] c = -A[:2, 2]``. The circle's centre projects to ``H (0, 0, 1)``.
 Exact for any pose with the circle wholly in front of the camera.
+
+Closed form (:func:`circle_center_bias_many_px`): the ellipse's centre is the pole of the line
+at infinity, ``c ~ A⁻¹ (0, 0, 1) = H diag(1, 1, -1/r²) Hᵀ (0, 0, 1)``; with ``Hᵀ (0, 0, 1) =
+(e1_z, e2_z, C_z)`` and ``e1 e1_z + e2 e2_z = z - n n_z`` (``z`` the optical axis, ``n`` the unit
+normal) it is the projection of the point ``C C_z - r² (z - n n_z)``: no plane axes, no
+inverse, any number of circles at once.
 """
 
 from __future__ import annotations
@@ -38,6 +44,26 @@ def conic_center(A: np.ndarray) -> np.ndarray:
     return np.linalg.solve(A[:2, :2], -A[:2, 2])
 
 
+def circle_center_bias_many_px(
+    K: np.ndarray, centers_cam_m: np.ndarray, normals_cam: np.ndarray, radii_m: np.ndarray
+) -> np.ndarray:
+    """:func:`circle_center_bias_px` of ``n`` circles at once (closed form, module doc):
+    centres (n, 3) m in the camera frame, every one in front of it; normals (n, 3), either sign,
+    any length; radii (n,) m. Returns (n, 2) ideal pixels."""
+    C = np.asarray(centers_cam_m, dtype=float).reshape(-1, 3)
+    n = np.asarray(normals_cam, dtype=float).reshape(-1, 3)
+    r = np.broadcast_to(np.asarray(radii_m, dtype=float), (len(C),))
+    if len(C) and not np.all(C[:, 2] > 0):
+        z = C[np.argmin(C[:, 2]), 2]
+        raise ValueError(f"circle centre must be in front of the camera (z > 0), got z = {z}")
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    v = C * C[:, 2:3] + (r**2)[:, None] * (n * n[:, 2:3])
+    v[:, 2] -= r**2
+    K = np.asarray(K, dtype=float)
+    ev, pc = v @ K.T, C @ K.T
+    return ev[:, :2] / ev[:, 2:3] - pc[:, :2] / pc[:, 2:3]
+
+
 def circle_center_bias_px(
     K: np.ndarray, center_cam_m: np.ndarray, normal_cam: np.ndarray, radius_m: float
 ) -> np.ndarray:
@@ -52,9 +78,4 @@ def circle_center_bias_px(
 
     Subtract it from a detected ideal ellipse centre to get the projected centre.
     """
-    C = np.asarray(center_cam_m, dtype=float).reshape(3)
-    if C[2] <= 0:
-        raise ValueError(f"circle centre must be in front of the camera (z > 0), got z = {C[2]}")
-    A = circle_image_conic(K, C, normal_cam, radius_m)
-    p = np.asarray(K, dtype=float) @ C
-    return conic_center(A) - p[:2] / p[2]
+    return circle_center_bias_many_px(K, center_cam_m, normal_cam, np.array([radius_m]))[0]

@@ -7,7 +7,8 @@ import cv2
 import numpy as np
 import pytest
 
-from measure.markers import circle_center_bias_px
+from measure.markers import circle_center_bias_many_px, circle_center_bias_px
+from measure.markers.bias import circle_image_conic, conic_center
 from measure.markers.ellipse import fit_ellipse
 
 K = np.array([[4640.0, 0.0, 1223.5], [0.0, 4640.0, 1023.5], [0.0, 0.0, 1.0]])
@@ -59,3 +60,22 @@ def test_bias_of_a_tilted_5mm_dot_is_a_tenth_of_a_pixel():
 def test_bias_refuses_a_circle_behind_the_camera():
     with pytest.raises(ValueError, match="in front"):
         circle_center_bias_px(K, np.array([0.0, 0.0, -0.2]), np.array([0, 0, 1.0]), 0.002)
+
+
+def test_closed_form_of_many_circles_matches_the_conic_route():
+    """The batched closed form (pole of the line at infinity) against the image conic's centre
+    ``A[:2, :2] c = -A[:2, 2]`` circle by circle, over random poses, sizes and normal signs."""
+    rng = np.random.default_rng(7)
+    C = np.column_stack([rng.uniform(-0.15, 0.15, (200, 2)), rng.uniform(0.15, 1.2, 200)])
+    n = rng.normal(size=(200, 3))
+    n[:, 2] = -np.abs(n[:, 2]) - 0.3  # facing the camera, up to about 75 deg of tilt
+    n *= rng.choice([-1.0, 1.0], size=(200, 1)) * rng.uniform(0.5, 3.0, (200, 1))
+    r = rng.uniform(0.001, 0.01, 200)
+    many = circle_center_bias_many_px(K, C, n, r)
+    for k in range(200):
+        p = K @ C[k]
+        conic = conic_center(circle_image_conic(K, C[k], n[k], r[k])) - p[:2] / p[2]
+        np.testing.assert_allclose(many[k], conic, atol=1e-6)
+    assert np.abs(many).max() > 0.1  # the draw has biases that matter
+    with pytest.raises(ValueError, match="in front"):
+        circle_center_bias_many_px(K, np.vstack([C[:2], [[0.0, 0.0, -0.1]]]), n[:3], r[:3])
