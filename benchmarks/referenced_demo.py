@@ -17,8 +17,9 @@ error against the truth in the datum frame A|B|C in the hole plane (RMS, worst),
 within U and ``|reported - true| / U`` of the position characteristics (median and 95th
 percentile: 1 for an honest U at k = 2), the position characteristics with U <= 1/4 of their
 zone, the median U, the stops referenced, the survey's robot time and adjustment time, the
-resection's time per stop (median), the demo's wall time, and the median standard uncertainty
-of a referenced hole's position from the head's calibration, the survey's markers, the
+CPU time per stop of locating it (median; both passes of the bias and the resection,
+:func:`cell.run.referenced.locate_stop`), the demo's wall time, and the median standard
+uncertainty of a referenced hole's position from the head's calibration, the survey's markers, the
 resection, the circle fit and the part's temperature (``u_*_um``).
 ``--arm-x`` and ``--thermal-x`` multiply the arm's repeatability and the thermal drift;
 ``--sigma-floor-px`` sets the simulated head's centre-noise floor (default: the demo's,
@@ -99,7 +100,7 @@ def _figures(res, run_dir: Path, cell=None, truth: CellTruth | None = None) -> d
         q = _u_ratios(cell, truth, doc)
         if q:
             out["ratio_med"], out["ratio_p95"] = float(np.median(q)), float(np.quantile(q, 0.95))
-    locate = [t.get("locate_s") for t in res.run.hole_timings if "locate_s" in t]
+    locate = [t["locate_cpu_s"] for t in res.run.hole_timings if "locate_cpu_s" in t]
     out["locate_ms"] = 1e3 * float(np.median(locate)) if locate else float("nan")
     if res.survey is not None:
         s = res.survey

@@ -363,16 +363,9 @@ class Runner(ReferencePhase):
             exclude = label_circles(dets)
             if self.markers is not None:
                 located = locate_stop(self.markers, dets, T_arm, stop.hole_id)
-                if not located.referenced and (T_reg := self.registration.transform()) is not None:
-                    located = replace(located, T_cell_left_registered=T_reg @ T_arm)
-                if located.referenced:
-                    T_res = located.resection.T_cell_left
-                    located = replace(
-                        located, registered_m=self.registration.residual_m(T_arm, T_res)
-                    )
-                    if not located.flagged:  # a stop off the others does not move the fit
-                        self.registration.add(T_arm, T_res)
+                located = self.registration.place(located)
                 self._note_located(stop.hole_id, located)
+                clock.laps["locate_cpu_s"] = located.cpu_s
         clock.lap("locate_s")
         result, meas = inspect_hole(self.cell, self.geometry, self.model, self.stereo,
                                self.holes[stop.hole_id], k, pair.left, pair.right, st.q_rad,
