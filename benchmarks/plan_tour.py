@@ -274,13 +274,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--skip-c", action="store_true", help="skip the 10x-budget runs")
     ap.add_argument("--no-builtin", action="store_true")
+    known = sorted(p.stem for p in CELLS.glob("*.yaml"))
     ap.add_argument(
         "--cells",
         nargs="*",
-        default=sorted(p.stem for p in CELLS.glob("*.yaml")),
-        help="cells of benchmarks/cells/ by name (default: every one)",
+        default=known,
+        help="cells of benchmarks/cells/ by name (default: every one; none: give no name)",
     )
     args = ap.parse_args(argv)
+    for name in args.cells:
+        if name not in known:
+            ap.error(f"--cells {name}: not in {CELLS}; known: {' '.join(known)}")
     logging.basicConfig(level=logging.ERROR)
     print(f"load average before: {_load()}", file=sys.stderr)
     cells = [] if args.no_builtin else [parse_cell(builtin_cell_path().read_text(), "builtin")]
