@@ -20,7 +20,7 @@ from scipy.optimize import least_squares
 
 from cell.referencing.observations import MarkerView, T_left_right, ideal_pixels
 from measure import StereoCalibration
-from robots.transforms import invert, skew, so3_exp, so3_left_jacobian
+from robots.transforms import skew, so3_exp, so3_left_jacobian
 
 Array = NDArray[np.float64]
 
@@ -83,12 +83,6 @@ def _pose(T0: Array, x: Array) -> Array:
     return T
 
 
-def _project(T_cell_cam: Array, K: Array, P: Array) -> Array:
-    T_cam_cell = invert(T_cell_cam)
-    p = P @ T_cam_cell[:3, :3].T + T_cam_cell[:3, 3]
-    return (p[:, :2] / p[:, 2:3]) @ K[:2, :2].T + K[:2, 2]
-
-
 class _Obs:
     """Ideal-pixel observations of one view: rows (marker index, camera, uv)."""
 
@@ -108,16 +102,29 @@ class _Obs:
         self.marker, self.side, self.uv = self.marker[mask], self.side[mask], self.uv[mask]
 
 
+def _camera_points(
+    x: Array, T0: Array, obs: _Obs, P: Array, T_lr: Array
+) -> tuple[Array, Array, Array]:
+    """The left camera's rotation ``R`` (3, 3) at ``x``, each row's marker in the left camera's
+    frame ``q = R^T (P - t)`` and in its own camera's ``pc`` (the right's: ``R_lr^T (q -
+    t_lr)``), (k, 3) m."""
+    T = _pose(T0, x)
+    R = T[:3, :3]
+    q = (P[obs.marker] - T[:3, 3]) @ R
+    pc = q.copy()
+    right = obs.side == 1
+    pc[right] = (q[right] - T_lr[:3, 3]) @ T_lr[:3, :3]
+    return R, q, pc
+
+
 def _residuals(
     x: Array, T0: Array, obs: _Obs, P: Array, K: tuple[Array, Array], T_lr: Array, sigma: float
 ) -> Array:
-    T = _pose(T0, x)
-    out = np.empty_like(obs.uv)
-    for s, T_cam in enumerate((T, T @ T_lr)):
-        m = obs.side == s
-        if m.any():
-            out[m] = _project(T_cam, K[s], P[obs.marker[m]]) - obs.uv[m]
-    return (out / sigma).ravel()
+    """Projected minus observed ideal pixels over ``sigma``, both cameras' rows at once."""
+    _, _, pc = _camera_points(x, T0, obs, P, T_lr)
+    Kr = np.stack(K)[obs.side]
+    uv = (Kr[:, :2, :2] @ (pc[:, :2] / pc[:, 2:3])[:, :, None])[:, :, 0] + Kr[:, :2, 2]
+    return ((uv - obs.uv) / sigma).ravel()
 
 
 def _pose_jacobian(
@@ -125,37 +132,21 @@ def _pose_jacobian(
 ) -> Array:
     """d :func:`_residuals` / d x (k, 6), analytic. With ``R = R0 exp(w)``, a change ``d`` of
     ``w`` turns ``R`` by ``phi = J_r(w) d`` on the right; the left camera's point
-    ``p = R^T (P - t)`` moves by ``[p]x phi``, the right camera's ``R_lr^T (q + [q]x phi) -
-    R_lr^T t_lr`` (``q = R^T (P - t)``) by ``R_lr^T [q]x phi``; a change of ``t`` moves either by
-    ``-R_cam^T``; then ``d uv / d p`` as in :func:`_marker_jacobian`."""
-    T = _pose(T0, x)
-    R, t = T[:3, :3], T[:3, 3]
-    Jr = so3_left_jacobian(-np.asarray(x[:3], float))
-    R_lr = T_lr[:3, :3]
-    J = np.zeros((2 * len(obs.uv), 6))
-    for s in (0, 1):
-        rows = np.flatnonzero(obs.side == s)
-        if len(rows) == 0:
-            continue
-        q = (P[obs.marker[rows]] - t) @ R  # R^T (P - t), per row
-        if s == 0:
-            pc, A, dt = q, np.eye(3), -R.T
-        else:
-            pc, A = q @ R_lr - T_lr[:3, 3] @ R_lr, R_lr.T
-            dt = -(R @ R_lr).T
-        z = pc[:, 2]
-        D = np.zeros((len(rows), 2, 3))
-        D[:, 0, 0] = D[:, 1, 1] = 1.0 / z
-        D[:, 0, 2], D[:, 1, 2] = -pc[:, 0] / z**2, -pc[:, 1] / z**2
-        KD = (K[s][:2, :2] / sigma) @ D  # (k, 2, 3)
-        skews = np.zeros((len(rows), 3, 3))
-        skews[:, 0, 1], skews[:, 0, 2], skews[:, 1, 2] = -q[:, 2], q[:, 1], -q[:, 0]
-        skews[:, 1, 0], skews[:, 2, 0], skews[:, 2, 1] = q[:, 2], -q[:, 1], q[:, 0]
-        Jw = (KD @ A) @ skews @ Jr
-        Jt = KD @ dt
-        J[2 * rows] = np.hstack([Jw[:, 0], Jt[:, 0]])
-        J[2 * rows + 1] = np.hstack([Jw[:, 1], Jt[:, 1]])
-    return J
+    ``q = R^T (P - t)`` moves by ``[q]x phi``, the right camera's ``R_lr^T (q - t_lr)`` by
+    ``R_lr^T [q]x phi``; a change of ``t`` moves either by ``-R_cam^T`` (``R_lr^T R^T`` for the
+    right); then ``d uv / d p`` as in :func:`_marker_jacobian`. Every row at once."""
+    R, q, pc = _camera_points(x, T0, obs, P, T_lr)
+    z = pc[:, 2]
+    D = np.zeros((len(z), 2, 3))
+    D[:, 0, 0] = D[:, 1, 1] = 1.0 / z
+    D[:, 0, 2], D[:, 1, 2] = -pc[:, 0] / z**2, -pc[:, 1] / z**2
+    A = np.stack([np.eye(3), T_lr[:3, :3].T])[obs.side]  # the row's camera from the left's
+    M = (np.stack(K)[obs.side][:, :2, :2] / sigma) @ D @ A  # (k, 2, 3)
+    skews = np.zeros((len(z), 3, 3))
+    skews[:, 0, 1], skews[:, 0, 2], skews[:, 1, 2] = -q[:, 2], q[:, 1], -q[:, 0]
+    skews[:, 1, 0], skews[:, 2, 0], skews[:, 2, 1] = q[:, 2], -q[:, 1], q[:, 0]
+    Jw = M @ skews @ so3_left_jacobian(-np.asarray(x[:3], float))
+    return np.concatenate([Jw, -M @ R.T], axis=2).reshape(-1, 6)
 
 
 def resect(
