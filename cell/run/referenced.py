@@ -32,7 +32,7 @@ from cell.referencing.detection import Detections, observe_detections
 from cell.referencing.head_term import referenced_head_covariance, used_view
 from cell.referencing.network import MarkerNetwork
 from cell.referencing.observations import MarkerView
-from cell.referencing.resection import Resection, resect
+from cell.referencing.resection import Resection, resect, resect_near
 from cell.uncertainty.budget import Contribution
 from measure import StereoCalibration
 from measure.calibration_uncertainty import CalibrationUncertainty
@@ -189,7 +189,8 @@ def locate_stop(
 ) -> LocatedStop:
     """Resect the head against the surveyed markers detected in the pair
     (:func:`cell.referencing.detection.detect_pair`), about the arm's pose; then once more with
-    the markers' perspective bias removed at the resected pose, so that the result does not
+    the markers' perspective bias removed at the resected pose (one Gauss-Newton step from it,
+    :func:`cell.referencing.resection.resect_near`), so that the result does not
     depend on the arm's prior (a prior 1.7 mm and 0.09 deg off moved the bias by up to 0.0013 px
     and the hole by up to 0.18 um; the arm's frame and the markers' differ by about 1 mm)."""
     cpu0 = time.thread_time()
@@ -202,7 +203,7 @@ def locate_stop(
         again = observe_detections(detections, network.head, network.codes, network.geometry,
                                    view_id, r.T_cell_left)  # fmt: skip
         # the first pass's refusals kept; this pass decides (its outlier test included)
-        r2 = resect(used_view(again, r.used), *args, network.covariance, *noise)
+        r2 = resect_near(used_view(again, r.used), *args, network.covariance, *noise)
         view, r = again, replace(r2, refused={**r.refused, **r2.refused})
     dt, dr = math.nan, math.nan
     if r.ok:
