@@ -19,7 +19,8 @@ percentile: 1 for an honest U at k = 2), the position characteristics with U <= 
 zone, the median U, the stops referenced, the survey's robot time (planned, and on the
 simulator's clock, which also runs while each pair renders) and adjustment time, the
 CPU time per stop of locating it (median; both passes of the bias and the resection,
-:func:`cell.run.referenced.locate_stop`), the demo's wall time, and the median standard
+:func:`cell.run.referenced.locate_stop`; ``replay_ms``: the same stops located again after the
+run, without its workers rendering beside them), the demo's wall time, and the median standard
 uncertainty of a referenced hole's position from the head's calibration, the survey's markers, the
 resection, the circle fit and the part's temperature (``u_*_um``).
 ``--arm-x`` and ``--thermal-x`` multiply the arm's repeatability and the thermal drift;
@@ -41,10 +42,12 @@ from pathlib import Path
 
 import numpy as np
 
+import cell.run.runner as run_module
 from cell.config import load_builtin_cell
 from cell.demo import survey as demo_survey
 from cell.demo.demo import DemoOptions, run_demo
 from cell.gdt.truth_check import coverage, true_evaluation
+from cell.run.referenced import locate_stop
 from cell.sim.truth import CellTruth
 from cell.sim.world import SimWorld, WorldOptions
 from robots.transforms import invert, so3_exp, so3_log
@@ -125,7 +128,29 @@ U_PARTS = {
 COLS = ("seed", "path", "views", "survey_rms_um", "survey_max_um", "scale_ppm", "within_2s",
         "sigma_eff_px", "survey_plan_s", "survey_robot_s", "survey_solve_s", "referenced",
         "holes_rms_um", "holes_max_um", "bestfit_rms_um", "within_U", "ratio_med", "ratio_p95",
-        "at_4to1", "n_pos", "U_median_um", "locate_ms", "wall_s", *U_PARTS.values())  # fmt: skip
+        "at_4to1", "n_pos", "U_median_um", "locate_ms", "replay_ms", "wall_s",
+        *U_PARTS.values())  # fmt: skip
+
+
+#: the arguments of every stop's :func:`locate_stop` in the run (replayed after it)
+_LOCATED: list[tuple] = []
+
+
+def _recording_locate(*args):
+    _LOCATED.append(args)
+    return locate_stop(*args)
+
+
+def _replayed_ms() -> float:
+    """Median CPU time (ms) of locating the run's stops again once it is over: the same stops
+    without the run's workers rendering beside them."""
+    times = []
+    for args in _LOCATED:
+        t0 = time.thread_time()
+        locate_stop(*args)
+        times.append(time.thread_time() - t0)
+    _LOCATED.clear()
+    return 1e3 * float(np.median(times)) if times else float("nan")
 
 
 def main() -> None:
@@ -147,6 +172,7 @@ def main() -> None:
     if args.sigma_floor_px is not None:
         demo_survey.SIM_SIGMA_FLOOR_PX = args.sigma_floor_px
     cell = load_builtin_cell()
+    run_module.locate_stop = _recording_locate  # the stops recorded for the replay
     print("  ".join(f"{c:>14}" for c in COLS), flush=True)
     for seed in range(args.first_seed, args.first_seed + args.seeds):
         t = CellTruth.drawn(seed, cell)
@@ -163,6 +189,7 @@ def main() -> None:
                 res = run_demo(run_dir, opts)
                 r = {"seed": seed, "path": path, **_figures(res, run_dir, cell, t)}
                 r["wall_s"] = time.perf_counter() - t0
+                r["replay_ms"] = _replayed_ms()
             print("  ".join(f"{r.get(c, float('nan')):>14.4g}" if isinstance(r.get(c), float)
                             else f"{r.get(c, '-')!s:>14}" for c in COLS), flush=True)  # fmt: skip
 
