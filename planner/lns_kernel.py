@@ -142,7 +142,7 @@ def improve_path(
 def _is_span(gnodes: NDArray[np.int64], b0: int, kb: int) -> bool:
     """True when ``gnodes[b0 : b0 + kb]`` are consecutive node ids (a hole's first nodes
     are; nodes added later to a hole's group are not)."""
-    for b in range(1, kb):
+    for b in range(1, kb):  # noqa: SIM110 (a plain loop: compiled by Numba)
         if gnodes[b0 + b] != gnodes[b0] + b:
             return False
     return True
