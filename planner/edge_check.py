@@ -50,9 +50,9 @@ class BatchEdgeChecker:
         """For each row pair (``starts[i]`` → ``ends[i]``, rad): True when the straight motion
         is within the limits and free of collision at the checker's resolution.
 
-        ``helper`` (:class:`planner.helper.Helper`): the second half of the motions' interior
-        samples is checked in the helper process while this one checks the first half, each
-        one configuration at a time (the same answers and counts as one process)."""
+        ``helper`` (:class:`planner.helper.Helper`): the interior samples of every
+        other motion are checked in the helper process while this one checks the others,
+        each one configuration at a time (the same answers and counts as one process)."""
         A, B = np.asarray(starts, dtype=float), np.asarray(ends, dtype=float)
         out = np.zeros(len(A), dtype=bool)
         if not len(A):
@@ -62,17 +62,17 @@ class BatchEdgeChecker:
         ends_in = np.all((lo <= A) & (hi >= A) & (last >= lo) & (last <= hi), axis=1)
         idx = np.flatnonzero(ends_in)
         if helper is not None and len(idx) >= 2 * HELPER_MIN_MOTIONS:
-            half = len(idx) // 2
+            # every other motion: the shares cost the same (motions near obstacles, which
+            # stop at their first collision, are not all in one half of the node ids)
+            here, there = idx[0::2], idx[1::2]
             c = self.checker
-            remote = helper.submit(interior_free, A[idx[half:]], B[idx[half:]], c.joint_step,
+            remote = helper.submit(interior_free, A[there], B[there], c.joint_step,
                                    c.tcp_step)  # fmt: skip
-            mine = self._interiors(A[idx[:half]], B[idx[:half]], one_at_a_time=True)
-            theirs = Helper.result(
-                remote, lambda: self._interiors(A[idx[half:]], B[idx[half:]], True)
-            )
-            inner_in, inner_free, sizes = (
-                np.concatenate([x, y]) for x, y in zip(mine, theirs, strict=True)
-            )
+            mine = self._interiors(A[here], B[here], one_at_a_time=True)
+            theirs = Helper.result(remote, lambda: self._interiors(A[there], B[there], True))
+            inner_in, inner_free, sizes = (np.empty(len(idx), dtype=x.dtype) for x in mine)
+            for whole, x, y in zip((inner_in, inner_free, sizes), mine, theirs, strict=True):
+                whole[0::2], whole[1::2] = x, y
         else:
             inner_in, inner_free, sizes = self._interiors(A[idx], B[idx])
         todo = idx[inner_in]

@@ -139,6 +139,16 @@ def improve_path(
 
 
 @njit(cache=True)
+def _is_span(gnodes: NDArray[np.int64], b0: int, kb: int) -> bool:
+    """True when ``gnodes[b0 : b0 + kb]`` are consecutive node ids (a hole's first nodes
+    are; nodes added later to a hole's group are not)."""
+    for b in range(1, kb):  # noqa: SIM110 (a plain loop: compiled by Numba)
+        if gnodes[b0 + b] != gnodes[b0] + b:
+            return False
+    return True
+
+
+@njit(cache=True)
 def layered(
     G: NDArray[np.float64],
     order: NDArray[np.int64],
@@ -165,15 +175,27 @@ def layered(
         b0 = goff[order[li]]
         kb = goff[order[li] + 1] - b0
         new[:kb] = np.inf
-        back[li, :kb] = 0
-        for a in range(ka):  # rows of G, read along: the first a with the least total wins
-            row = gnodes[a0 + a]
-            da = dist[a]
-            for b in range(kb):
-                t = da + G[row, gnodes[b0 + b]]
-                if t < new[b]:
-                    new[b] = t
-                    back[li, b] = a
+        bk = back[li]
+        bk[:kb] = 0
+        c0 = gnodes[b0]
+        if _is_span(gnodes, b0, kb):  # the hole's nodes are columns c0 .. c0+kb-1 of G
+            for a in range(ka):  # a contiguous slice of a row: the inner loop vectorises
+                row = G[gnodes[a0 + a], c0 : c0 + kb]
+                da = dist[a]
+                for b in range(kb):
+                    t = da + row[b]
+                    if t < new[b]:
+                        new[b] = t
+                        bk[b] = a
+        else:
+            for a in range(ka):  # rows of G, read along: the first a with the least total wins
+                r = gnodes[a0 + a]
+                da = dist[a]
+                for b in range(kb):
+                    t = da + G[r, gnodes[b0 + b]]
+                    if t < new[b]:
+                        new[b] = t
+                        bk[b] = a
         dist[:kb] = new[:kb]
         a0, ka = b0, kb
     best, pick = np.inf, 0

@@ -195,7 +195,7 @@ class TourPlanner(LazyEdgeChecks):
             if not free:  # a collision at a coarse sample is one at the set resolution too
                 self._edge_free[(u, v)] = False
                 blocked += [(u, v), (v, u)]
-        seqr.learn(detour_costs(self._roadmap, seqr.G, blocked))
+        seqr.learn(detour_costs(self._roadmap, seqr.G, blocked, helper))
 
     def _sequence_and_paths(
         self,

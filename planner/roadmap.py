@@ -18,6 +18,7 @@ is offered, do not depend on the seed or on which edges a random search visited.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 from numpy.typing import NDArray
@@ -172,30 +173,84 @@ def build_roadmap(
     return rm
 
 
+#: with a helper, Dijkstra's sources are shared from this many on (below, one process)
+HELPER_MIN_SOURCES = 64
+
+
+def _walk(pred: NDArray[np.int32], a: int, b: int) -> list[int]:
+    """Intermediate nodes of the shortest path ``a`` -> ``b`` from Dijkstra's predecessors."""
+    path, x = [], b
+    while x != a:
+        x = int(pred[x])
+        path.append(x)
+    return path[::-1][1:]
+
+
+def _shortest(
+    dist_pred: list[tuple[NDArray[np.float64], NDArray[np.int32]]],
+    sources: list[int],
+    pairs: list[tuple[int, int]],
+) -> dict[tuple[int, int], tuple[float, list[int]]]:
+    """Distance (s) and intermediate nodes of each of ``pairs`` (sources among ``sources``,
+    whose Dijkstra rows ``dist_pred`` are) that the roadmap joins."""
+    row = dict(zip(sources, dist_pred, strict=True))
+    out = {}
+    for a, b in pairs:
+        dist, pred = row[a]
+        if np.isfinite(dist[b]):
+            out[(a, b)] = (float(dist[b]), _walk(pred, a, b))
+    return out
+
+
+def detours_in_helper(
+    u: NDArray[np.int64], v: NDArray[np.int64], weights: NDArray[np.float64], n: int,
+    sources: list[int], pairs: list[tuple[int, int]],
+) -> dict[tuple[int, int], tuple[float, list[int]]]:  # fmt: skip
+    """In the helper: :func:`_shortest` of ``pairs`` over the free motions ``u``-``v`` of
+    ``weights`` (s) among ``n`` nodes (the same Dijkstra call as :meth:`Roadmap.shortest_from`:
+    each row depends on its source and the weights only)."""
+    graph = csr_matrix((weights, (u, v)), shape=(n, n))
+    dist, pred = dijkstra(graph, directed=False, indices=sources, return_predecessors=True)
+    return _shortest(list(zip(dist, pred, strict=True)), sources, pairs)
+
+
 def detour_costs(
-    rm: Roadmap, G: NDArray[np.float64], blocked: list[tuple[int, int]]
+    rm: Roadmap,
+    G: NDArray[np.float64],
+    blocked: list[tuple[int, int]],
+    helper: Helper | None = None,
 ) -> dict[tuple[int, int], float]:
     """Costs (s) of the ``blocked`` motions: shortest roadmap path, else the estimate.
 
-    Records each detour's intermediate nodes in ``rm.detours``.
+    Records each detour's intermediate nodes in ``rm.detours``. ``helper``: Dijkstra from
+    every other source runs there meanwhile (the same paths; their rows are not kept here).
     """
     if not blocked:
         return {}
     uv = np.array(blocked, dtype=np.int64).reshape(-1, 2)
     u, v = uv[:, 0], uv[:, 1]
     cost = DETOUR_FACTOR * G[u, v] + DETOUR_EXTRA_S
+    pairs = [(a, b) for a, b in uv.tolist()]
     sources = sorted(set(u.tolist()))
+    remote = None
+    if helper is not None and len(sources) >= HELPER_MIN_SOURCES:
+        rm.shortest_from(G, [])  # the free motions as arrays, the kept rows checked
+        _, eu, ev = rm._edges if rm._edges is not None else (0, u[:0], u[:0])
+        if len(eu):
+            there = sources[1::2]
+            sources = sources[0::2]
+            mine = set(sources)
+            theirs = [p for p in pairs if p[0] not in mine]
+            pairs = [p for p in pairs if p[0] in mine]
+            args = (eu, ev, np.maximum(G[eu, ev], 1e-9), G.shape[0], there, theirs)
+            remote = (helper.submit(detours_in_helper, *args), partial(detours_in_helper, *args))
     found = rm.shortest_from(G, sources)
-    if found is not None:
-        row = dict(zip(sources, found, strict=True))
-        for i, (a, b) in enumerate(uv.tolist()):
-            dist, pred = row[a]
-            if not np.isfinite(dist[b]):
-                continue
-            cost[i] = max(float(dist[b]), float(G[a, b]))
-            path, x = [], b
-            while x != a:
-                x = int(pred[x])
-                path.append(x)
-            rm.detours[(a, b)] = path[::-1][1:]
+    paths = {} if found is None else _shortest(found, sources, pairs)
+    if remote is not None:
+        paths |= Helper.result(*remote)
+    for i, (a, b) in enumerate(uv.tolist()):
+        got = paths.get((a, b))
+        if got is not None:
+            cost[i] = max(got[0], float(G[a, b]))
+            rm.detours[(a, b)] = got[1]
     return {(a, b): c for (a, b), c in zip(uv.tolist(), cost.tolist(), strict=True)}

@@ -164,3 +164,35 @@ def test_neighbour_lists_made_half_in_the_helper_equal_one_process(cell) -> None
     want = neighbour_pairs(G, owner, 5)
     assert np.array_equal(got, want)
     assert [2, far] in want.tolist()
+
+
+def test_detours_with_dijkstra_shared_with_the_helper_equal_one_process(cell) -> None:
+    """Every other source's Dijkstra in the helper: the same costs and detour paths as one
+    process (ties of equal weights included), and a dead helper leaves its share here."""
+    import os
+    import signal
+
+    from planner.roadmap import HELPER_MIN_SOURCES, Roadmap, detour_costs
+
+    rng = np.random.default_rng(8)
+    n = 3 * HELPER_MIN_SOURCES
+    X = rng.random((n, 2))
+    G = np.round(np.sqrt(((X[:, None] - X[None]) ** 2).sum(-1)) * 20) / 20  # ties
+    pairs = {(int(a), int(b)) for a, b in rng.integers(0, n, (8 * n, 2)) if a < b}
+    free = {p: bool(rng.random() < 0.7) and min(p) > 2 for p in sorted(pairs)}  # 0-2: cut off
+    blocked = [q for (a, b), f in free.items() if not f for q in ((a, b), (b, a))]
+    assert len({a for a, _ in blocked}) >= HELPER_MIN_SOURCES
+    alone = Roadmap(free=dict(free))
+    want = detour_costs(alone, G, blocked)
+    for kill in (False, True):
+        rm = Roadmap(free=dict(free))
+        helper = Helper.start(MIN_HOLES)
+        assert helper is not None
+        if kill:
+            for pid in list(helper.pool._processes):
+                os.kill(pid, signal.SIGKILL)
+        got = detour_costs(rm, G, blocked, helper)
+        helper.close()
+        assert got == want and rm.detours == alone.detours
+    assert any(np.isfinite(c) and c > G[a, b] for (a, b), c in want.items())  # real detours
+    assert len(alone.detours) < len(blocked)  # and motions without one (the estimate)

@@ -51,6 +51,31 @@ def test_kernels_equal_the_numpy_reference_bit_for_bit(seed: int) -> None:
     assert (o.tolist(), v.tolist()) == ref
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_layered_equals_the_reference_for_groups_of_consecutive_and_scattered_nodes(
+    seed: int,
+) -> None:
+    """Holes whose nodes are consecutive ids (read as one slice of a row) and holes with
+    nodes added later (scattered ids, as :meth:`GtspSequencer.add_nodes` makes): the same
+    nodes and cost as the numpy reference, ties included."""
+    G, groups, _gnodes, _goff, rng = _instance(30, seed, ties=seed % 2 == 0)
+    extra = rng.choice(len(groups), size=8, replace=False)
+    N = G.shape[0]
+    X = rng.random((N + len(extra), 3))
+    D = np.sqrt(((X[:, None] - X[None]) ** 2).sum(-1))
+    G = np.round(D * 20) / 20 if seed % 2 == 0 else D  # rounded: ties
+    groups = [g.copy() for g in groups]
+    for i, h in enumerate(extra):
+        groups[h] = np.append(groups[h], N + i)  # a later node: not next to the others
+    gnodes = np.concatenate(groups).astype(np.int64)
+    goff = np.cumsum([0, *[len(g) for g in groups]]).astype(np.int64)
+    for _ in range(5):
+        order = rng.permutation(len(groups))
+        nodes, cost = layered(G, order.astype(np.int64), gnodes, goff)
+        ref_nodes, ref_cost = layered_nodes(G, [groups[h] for h in order])
+        assert nodes.tolist() == ref_nodes and cost == ref_cost
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_the_compiled_search_finds_the_numpy_search_s_tour(seed: int) -> None:
     G, groups, *_ = _instance(40, seed, ties=seed == 0)
