@@ -7,7 +7,8 @@ unknowns). A marker whose residual exceeds :data:`OUTLIER_SIGMA` (it moved since
 it is misidentified) is refused by id and the pose solved again while at least
 :data:`MIN_MARKERS` remain; with fewer the stop is not referenced (``ok`` False: the run falls
 back to the arm). The covariance holds the image noise and the survey's marker covariance
-(``A C_markers A^T`` with ``A = (J^T J)^-1 J^T J_markers``).
+(``A C_markers A^T`` with ``A = (J^T J)^-1 J^T J_markers``). :func:`resect_near` takes one
+Gauss-Newton step instead, from a pose already resected from nearly the same centres.
 """
 
 from __future__ import annotations
@@ -134,7 +135,8 @@ def _pose_jacobian(
     ``w`` turns ``R`` by ``phi = J_r(w) d`` on the right; the left camera's point
     ``q = R^T (P - t)`` moves by ``[q]x phi``, the right camera's ``R_lr^T (q - t_lr)`` by
     ``R_lr^T [q]x phi``; a change of ``t`` moves either by ``-R_cam^T`` (``R_lr^T R^T`` for the
-    right); then ``d uv / d p`` as in :func:`_marker_jacobian`. Every row at once."""
+    right); then ``d uv / d p = K2 [[1/z, 0, -x/z^2], [0, 1/z, -y/z^2]]`` (``K2`` the focal part
+    of the row's camera matrix) over the pixel sigma. Every row at once."""
     R, q, pc = _camera_points(x, T0, obs, P, T_lr)
     z = pc[:, 2]
     D = np.zeros((len(z), 2, 3))
