@@ -48,8 +48,7 @@ def referenced_head_covariance(
     positions_cell: Array,
     T_cell_left: Array,
     points_left_m: Array,
-    sigma_px: float,
-) -> Array | None:
+) -> Array:
     """The covariance (3, 3) m², cell frame, of a referenced hole's centre from the head's
     calibration uncertainty ``unc`` (module doc). ``view``: the stop's markers (only those the
     resection used); ``T_cell_left``: its resected pose; ``points_left_m``: the hole's inlier

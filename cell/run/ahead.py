@@ -31,8 +31,9 @@ STOPS_AHEAD = 2
 class PairsAhead:
     """Captures of ``camera`` whose pairs come later: rendered in the process's pool of
     ``workers`` processes (:func:`cell.camera.workers.executor`) when the camera takes
-    snapshots, one stop ahead; ``keep_dir``: the run directory the pairs are kept in (None:
-    none kept); ``markers``: the head and the marker codes to find in each rendered pair."""
+    snapshots, :data:`STOPS_AHEAD` stops ahead; ``keep_dir``: the run directory the pairs are
+    kept in (None: none kept); ``markers``: the head and the marker codes to find in each
+    rendered pair."""
 
     def __init__(
         self, camera: CameraBackend, keep_dir: Path | None, workers: int = 2,

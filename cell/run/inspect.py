@@ -122,7 +122,7 @@ def inspect_hole(
     if referenced:
         rows = {c.name: c for c in contributions}
         inliers = np.asarray(meas.points_m, float)[np.asarray(meas.inliers, bool)]
-        head = HeadInputs(stereo, ctx.calibration, inliers, located.resection_sigma_px)
+        head = HeadInputs(stereo, ctx.calibration, inliers)
         contributions = referenced_contributions(
             located, meas.center_m, T_part_cell[:3, :3], rows["circle_fit"],
             rows["stereo_calibration"], rows["part_temperature"], network_source,

@@ -111,13 +111,11 @@ class ArmRegistration:
 @dataclass(frozen=True)
 class HeadInputs:
     """What the head's calibration row of a referenced stop needs: the head the hole was
-    measured with, its uncertainty, the hole's inlier edge points (left frame, m) and the
-    centre noise the resection weighs with (px)."""
+    measured with, its uncertainty and the hole's inlier edge points (left frame, m)."""
 
     stereo: StereoCalibration
     uncertainty: CalibrationUncertainty
     points_left_m: Array
-    sigma_px: float
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,8 +141,6 @@ class LocatedStop:
     #: the head's calibration row, :func:`cell.referencing.head_term.referenced_head_covariance`)
     marker_ids: tuple[str, ...] = ()
     marker_positions: Array | None = None
-    #: the centre noise the resection weighed the markers with (px)
-    resection_sigma_px: float = 0.05
     #: the CPU time :func:`locate_stop` took (s): both passes of the bias and the resection
     cpu_s: float = math.nan
 
@@ -224,7 +220,6 @@ def locate_stop(
         marker_factor=factor,
         marker_ids=network.ids,
         marker_positions=network.positions_cell,
-        resection_sigma_px=network.sigma_px,
         cpu_s=time.thread_time() - cpu0,
     )
 
@@ -260,14 +255,12 @@ def referenced_contributions(
     if head is not None and located.marker_positions is not None:
         cov = referenced_head_covariance(
             head.stereo, head.uncertainty, used_view(located.view, r.used), located.marker_ids,
-            located.marker_positions, r.T_cell_left, head.points_left_m, head.sigma_px,
+            located.marker_positions, r.T_cell_left, head.points_left_m,
         )  # fmt: skip
-        if cov is not None:
-            calibration = Contribution(
-                calibration.name, R_part_cell @ cov @ R_part_cell.T, calibration.var_diameter_m2,
-                f"{calibration.note}; through the hole and the {len(r.used)} markers of the "
-                "same pair",
-            )  # fmt: skip
+        calibration = Contribution(
+            calibration.name, R_part_cell @ cov @ R_part_cell.T, calibration.var_diameter_m2,
+            f"{calibration.note}; through the hole and the {len(r.used)} markers of the same pair",
+        )  # fmt: skip
     J = R_part_cell @ r.point_jacobian(center_left_m)
     cov_m = r.covariance_markers if r.covariance_markers is not None else np.zeros((6, 6))
     image = Contribution(

@@ -47,7 +47,7 @@ def test_the_head_row_is_the_error_a_head_off_by_one_sigma_gives(small_cell, ste
                                                                      + T[:3, 3])  # fmt: skip
         pts = retriangulate(stereo, px_l, px_r)
         cov = referenced_head_covariance(stereo, _only(index, sigma), used_view(view, r.used),
-                                         ids, P, r.T_cell_left, pts, 0.05)  # fmt: skip
+                                         ids, P, r.T_cell_left, pts)  # fmt: skip
         assert cov is not None
         stated = np.sqrt(np.trace(cov))
         assert abs(np.linalg.norm(error) - stated) < 0.02 * stated
