@@ -62,14 +62,9 @@ class Roadmap:
         motions weighted by the current ``G`` (None: no free motion). Rows already computed
         for the same weights are reused (the same numbers: a row depends on its source and
         the weights only)."""
-        if self._edges is None or self._edges[0] != len(self.free):
-            e = np.array([uv for uv, f in self.free.items() if f], dtype=np.int64).reshape(-1, 2)
-            self._edges = (len(self.free), e[:, 0], e[:, 1])
-            self._weights = None
-        _, u, v = self._edges
+        u, v, weights = self.free_edges(G)
         if not len(u):
             return None
-        weights = np.maximum(G[u, v], 1e-9)
         grown = any(len(row[0]) != G.shape[0] for row in self._rows.values())  # nodes added
         if self._weights is None or grown or not np.array_equal(self._weights, weights):
             self._rows, self._weights = {}, weights
@@ -80,6 +75,18 @@ class Roadmap:
             dist, pred = dijkstra(graph, directed=False, indices=todo, return_predecessors=True)
             self._rows.update(zip(todo, zip(dist, pred, strict=True), strict=True))
         return [self._rows[s] for s in sources]
+
+    def free_edges(
+        self, G: NDArray[np.float64]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+        """The free motions ``u``-``v`` and their weights in Dijkstra's graph (s: ``G``'s,
+        above 0)."""
+        if self._edges is None or self._edges[0] != len(self.free):
+            e = np.array([uv for uv, f in self.free.items() if f], dtype=np.int64).reshape(-1, 2)
+            self._edges = (len(self.free), e[:, 0], e[:, 1])
+            self._weights = None
+        _, u, v = self._edges
+        return u, v, np.maximum(G[u, v], 1e-9)
 
     def via(self, u: int, v: int) -> list[int] | None:
         """Intermediate nodes of the roadmap detour from ``u`` to ``v`` (None: none known)."""
@@ -234,15 +241,14 @@ def detour_costs(
     sources = sorted(set(u.tolist()))
     remote = None
     if helper is not None and len(sources) >= HELPER_MIN_SOURCES:
-        rm.shortest_from(G, [])  # the free motions as arrays, the kept rows checked
-        _, eu, ev = rm._edges if rm._edges is not None else (0, u[:0], u[:0])
+        eu, ev, weights = rm.free_edges(G)
         if len(eu):
             there = sources[1::2]
             sources = sources[0::2]
             mine = set(sources)
             theirs = [p for p in pairs if p[0] not in mine]
             pairs = [p for p in pairs if p[0] in mine]
-            args = (eu, ev, np.maximum(G[eu, ev], 1e-9), G.shape[0], there, theirs)
+            args = (eu, ev, weights, G.shape[0], there, theirs)
             remote = (helper.submit(detours_in_helper, *args), partial(detours_in_helper, *args))
     found = rm.shortest_from(G, sources)
     paths = {} if found is None else _shortest(found, sources, pairs)
