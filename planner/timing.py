@@ -94,7 +94,16 @@ class TimedMotion:
 
     def positions(self, times: ArrayLike) -> NDArray[np.float64]:
         """Joint positions (rad), one row per time in ``times`` (s from the motion's start)."""
-        return np.array([self.state(float(t))[0] for t in np.atleast_1d(times)])
+        t = np.atleast_1d(np.asarray(times, dtype=float))
+        if not self.pieces:
+            return np.repeat(self.waypoints[:1], len(t), axis=0)
+        # :meth:`state`'s clamping and piece lookup for every time at once (the same numbers)
+        t = np.minimum(np.maximum(t, 0.0), self.duration)
+        ks = np.searchsorted(self.piece_starts, t, side="right") - 1
+        ks = np.minimum(np.maximum(ks, 0), len(self.pieces) - 1)
+        local = (t - self.piece_starts[ks]).tolist()
+        at = [p.at_time for p in self.pieces]
+        return np.array([at[k](x)[0] for k, x in zip(ks.tolist(), local, strict=True)])
 
     def piece_positions(self, k: int, dt: float) -> NDArray[np.float64]:
         """Positions of piece ``k`` sampled every ``dt`` s, both ends included."""

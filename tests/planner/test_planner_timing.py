@@ -84,3 +84,18 @@ def test_timeline_with_dwell_is_sampled_at_dt() -> None:
 def test_finite_difference_check_catches_a_too_fast_trajectory() -> None:
     q = np.outer(np.arange(100) * DT, np.full(6, 1.5 * V.max()))
     assert not finite_difference_limits(q, DT, LIMITS).within(TOL)
+
+
+def test_positions_equal_state_sample_by_sample() -> None:
+    """The batched ``positions`` gives ``state``'s positions bit for bit, before the start,
+    on each piece's boundaries and after the end included."""
+    rng = np.random.default_rng(3)
+    W = rng.uniform(-1.0, 1.0, (5, 6))
+    motion = through_waypoints(W, LIMITS, np.array([True, False, True, False, True]))
+    assert len(motion.pieces) == 4
+    t = np.concatenate(
+        [[-0.1, 0.0], motion.piece_starts, rng.uniform(0, motion.duration, 50), [1e3]]
+    )
+    expected = np.array([motion.state(float(x))[0] for x in t])
+    assert np.array_equal(motion.positions(t), expected)
+    assert not np.array_equal(expected[2], expected[3])  # the samples differ (not one row)
