@@ -82,17 +82,17 @@ def viewpoint_poses(
 ) -> NDArray[np.float64]:
     """Every sampled ``T_cell_tcp`` (p, 4, 4) viewing the hole centre from ``standoff_m``."""
     rolls = np.radians(np.arange(0.0, 360.0 - 1e-9, roll_step_deg))
-    poses = []
-    for z in view_directions(normal, tilt_deg, tilt_azimuths):
+    c, s = np.cos(rolls)[:, None], np.sin(rolls)[:, None]
+    dirs = view_directions(normal, tilt_deg, tilt_azimuths)
+    poses = np.zeros((len(dirs), len(rolls), 4, 4))
+    poses[..., 3, 3] = 1.0
+    for T, z in zip(poses, dirs, strict=True):  # every roll of a direction at once
         x0, y0 = _basis(z)
-        origin = np.asarray(position_m, dtype=float) - standoff_m * z
-        for roll in rolls:
-            c, s = np.cos(roll), np.sin(roll)
-            T = np.eye(4)
-            T[:3, :3] = np.column_stack((c * x0 + s * y0, -s * x0 + c * y0, z))
-            T[:3, 3] = origin
-            poses.append(T)
-    return np.array(poses)
+        T[:, :3, 0] = c * x0 + s * y0
+        T[:, :3, 1] = -s * x0 + c * y0
+        T[:, :3, 2] = z
+        T[:, :3, 3] = np.asarray(position_m, dtype=float) - standoff_m * z
+    return poses.reshape(-1, 4, 4)
 
 
 def _describe_collisions(arm: ArmLike, samples: list[NDArray[np.float64]]) -> str:
@@ -146,8 +146,10 @@ def hole_candidates(
     )
     ik_reasons: Counter[str] = Counter()
     sols, branches, pose_of = [], [], []
+    many = getattr(arm, "ik_many", None)  # every pose in one call (robots.Arm.ik_many)
+    results = many(poses[known_empty:]) if many is not None else None
     for p in range(known_empty, len(poses)):
-        result = arm.ik(poses[p])
+        result = results[p - known_empty] if results is not None else arm.ik(poses[p])
         if not result.ok:
             ik_reasons[result.reason or "no IK solution"] += 1
             continue

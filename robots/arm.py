@@ -20,7 +20,7 @@ from robots.collision import Clearance, CollisionModel
 from robots.collision_batch import BatchCollision
 from robots.dh import DHTable, fk_dh, point_dh
 from robots.errors import JointVectorError, UnknownModelError, UrdfError
-from robots.ik import IKResult, solve_opw
+from robots.ik import IKResult, solve_opw, solve_opw_many
 from robots.limits import narrowed_limits
 from robots.models import (
     ACCEL_PER_SPEED,
@@ -232,6 +232,12 @@ class Arm:
         """Every joint solution placing the TCP at ``T_cell_tcp`` (see :mod:`robots.ik`)."""
         T_base_tool0 = self._T_base_cell @ np.asarray(T_cell_tcp, float) @ self._T_tcp_tool0
         return solve_opw(self.opw, T_base_tool0, self.lower, self.upper)
+
+    def ik_many(self, T_cell_tcp: ArrayLike) -> list[IKResult]:
+        """:meth:`ik` of each pose of ``T_cell_tcp`` (P, 4, 4), the same results, in one call
+        (:func:`robots.ik.solve_opw_many`)."""
+        T = [self._T_base_cell @ P @ self._T_tcp_tool0 for P in np.asarray(T_cell_tcp, float)]
+        return solve_opw_many(self.opw, np.array(T), self.lower, self.upper)
 
     # -- collision ---------------------------------------------------------------------------
     def in_collision(self, q: ArrayLike) -> bool:

@@ -118,3 +118,35 @@ def test_out_of_reach_and_singular_wrist() -> None:
     assert _wrist_solutions(0.0, np.pi / 2, [[1, 0, 0], [0, -1, 0], [0, 0, -1]]) == []
     above = make_transform(Rotation.from_euler("y", np.pi).as_matrix(), [0.0, 0.0, 1.5])
     assert arm.ik(above).reason == "shoulder singular"
+
+
+def test_many_poses_solve_as_one_at_a_time_bit_for_bit() -> None:
+    """``Arm.ik_many`` gives each pose ``Arm.ik``'s result, the same bits and reasons: random
+    reachable poses (several branches), out of reach, a singular wrist, shoulder singular,
+    and solutions outside narrowed limits."""
+    arm = Arm()
+    rng = np.random.default_rng(7)
+    poses = [arm.fk(q) for q in rng.uniform(arm.lower, arm.upper, (60, 6))]
+    poses += [
+        make_transform(np.eye(3), [3.0, 0.0, 1.0]),
+        arm.fk(np.array([0.3, 0.2, -0.1, 0.5, 0.0, 0.2])),
+        make_transform(Rotation.from_euler("y", np.pi).as_matrix(), [0.0, 0.0, 1.5]),
+    ]
+    P = np.array(poses)
+    many = arm.ik_many(P)
+    one = [arm.ik(T) for T in P]
+    reasons = {r.reason for r in one}
+    assert {None, "out of reach", "shoulder singular"} <= reasons
+    assert len(many) == len(one)
+    for a, b in zip(many, one, strict=True):
+        assert np.array_equal(a.solutions, b.solutions) and a.solutions.dtype == b.solutions.dtype
+        assert np.array_equal(a.branches, b.branches)
+        assert (a.reason, a.n_branches) == (b.reason, b.n_branches)
+    arm.lower[4], arm.upper[4] = 0.7, 1.0  # a J5 window: most solutions leave the limits
+    many, one = arm.ik_many(P), [arm.ik(T) for T in P]
+    assert "outside limits" in {r.reason for r in one}
+    for a, b in zip(many, one, strict=True):
+        assert np.array_equal(a.solutions, b.solutions) and (a.reason, a.n_branches) == (
+            b.reason,
+            b.n_branches,
+        )
