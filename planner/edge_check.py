@@ -12,6 +12,10 @@ configuration at a time through ``in_collision``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -22,6 +26,8 @@ from robots.collision_batch import BatchCollision
 
 #: with a helper process, each process checks at least this many motions (else one does all)
 HELPER_MIN_MOTIONS = 500
+#: ... in this many chunks, taken by whichever process is free (:meth:`BatchEdgeChecker._share`)
+SHARE_CHUNKS = 32
 
 
 class BatchEdgeChecker:
@@ -50,9 +56,9 @@ class BatchEdgeChecker:
         """For each row pair (``starts[i]`` → ``ends[i]``, rad): True when the straight motion
         is within the limits and free of collision at the checker's resolution.
 
-        ``helper`` (:class:`planner.helper.Helper`): the interior samples of every
-        other motion are checked in the helper process while this one checks the others,
-        each one configuration at a time (the same answers and counts as one process)."""
+        ``helper`` (:class:`planner.helper.Helper`): the interior samples are checked in
+        chunks shared with the helper process (:meth:`_share`), each one configuration at a
+        time (the same answers and counts as one process)."""
         A, B = np.asarray(starts, dtype=float), np.asarray(ends, dtype=float)
         out = np.zeros(len(A), dtype=bool)
         if not len(A):
@@ -61,31 +67,59 @@ class BatchEdgeChecker:
         last = A + 1.0 * (B - A)  # the last sample of np.linspace's motion
         ends_in = np.all((lo <= A) & (hi >= A) & (last >= lo) & (last <= hi), axis=1)
         idx = np.flatnonzero(ends_in)
+        if not len(idx):
+            return out
+        collect = None
         if helper is not None and len(idx) >= 2 * HELPER_MIN_MOTIONS:
-            # every other motion: the shares cost the same (motions near obstacles, which
-            # stop at their first collision, are not all in one half of the node ids)
-            here, there = idx[0::2], idx[1::2]
-            c = self.checker
-            remote = helper.submit(interior_free, A[there], B[there], c.joint_step,
-                                   c.tcp_step)  # fmt: skip
-            mine = self._interiors(A[here], B[here], one_at_a_time=True)
-            theirs = Helper.result(remote, lambda: self._interiors(A[there], B[there], True))
-            inner_in, inner_free, sizes = (np.empty(len(idx), dtype=x.dtype) for x in mine)
-            for whole, x, y in zip((inner_in, inner_free, sizes), mine, theirs, strict=True):
-                whole[0::2], whole[1::2] = x, y
+            inner_in, inner_free, sizes, collect = self._share(A[idx], B[idx], helper)
         else:
             inner_in, inner_free, sizes = self._interiors(A[idx], B[idx])
-        todo = idx[inner_in]
-        if not len(todo):
-            return out
         # the motions share their ends (each node is the end of many): every distinct end
-        # configuration is checked once
-        uniq, which = np.unique(np.vstack([A[todo], B[todo]]), axis=0, return_inverse=True)
-        which = which.reshape(2, len(todo))
-        self.checks += len(uniq) + int(sizes[inner_in].sum())
+        # configuration is checked once, here, while the helper finishes its last chunks
+        uniq, which = np.unique(np.vstack([A[idx], B[idx]]), axis=0, return_inverse=True)
+        which = which.reshape(2, len(idx))
         end_free = ~self._hits([e[:, None] for e in uniq])
-        out[todo] = end_free[which[0]] & end_free[which[1]] & inner_free[inner_in]
+        if collect is not None:
+            collect()
+        self.checks += len(uniq) + int(sizes[inner_in].sum())
+        out[idx] = end_free[which[0]] & end_free[which[1]] & inner_in & inner_free
         return out
+
+    def _share(
+        self, A: NDArray[np.float64], B: NDArray[np.float64], helper: Helper
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.int64], Callable[[], None]]:
+        """:meth:`_interiors` of the motions ``A`` → ``B``, in ``SHARE_CHUNKS`` chunks (every
+        ``SHARE_CHUNKS``-th motion: chunks of equal cost) that the helper takes from the last
+        while this process takes them from the first, one configuration per call; a chunk
+        the helper has not started when this process reaches it is done here. Returns the
+        arrays, filled where this process worked, and the call that fills in the helper's
+        chunks (waiting for them)."""
+        c = self.checker
+        chunks = [np.arange(j, len(A), SHARE_CHUNKS) for j in range(SHARE_CHUNKS)]
+        futures = {
+            j: helper.submit(interior_free, A[pos], B[pos], c.joint_step, c.tcp_step)
+            for j, pos in reversed(list(enumerate(chunks)))
+            if j > 0
+        }
+        whole = (np.empty(len(A), bool), np.empty(len(A), bool), np.empty(len(A), np.int64))
+
+        def put(pos: NDArray[np.int64], got: tuple[NDArray[Any], ...]) -> None:
+            for w, x in zip(whole, got, strict=True):
+                w[pos] = x
+
+        for j, pos in enumerate(chunks):
+            f = futures.get(j)
+            if f is not None and not f.cancel():
+                break  # the helper has it (and every chunk after it)
+            futures.pop(j, None)
+            put(pos, self._interiors(A[pos], B[pos], one_at_a_time=True))
+
+        def collect() -> None:
+            for j, f in futures.items():
+                pos = chunks[j]
+                put(pos, Helper.result(f, partial(self._interiors, A[pos], B[pos], True)))
+
+        return *whole, collect
 
     def _interiors(
         self, A: NDArray[np.float64], B: NDArray[np.float64], one_at_a_time: bool = False
@@ -128,10 +162,19 @@ class BatchEdgeChecker:
         )
 
 
+#: in the helper: its checker per resolution (made on its first chunk: a batch checker's
+#: pool of broad phases costs ~10 ms)
+_HELPER_CHECKERS: dict[tuple[int, float, float], BatchEdgeChecker] = {}
+
+
 def interior_free(
     A: NDArray[np.float64], B: NDArray[np.float64], joint_step: float, tcp_step: float
 ) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.int64]]:
     """:meth:`BatchEdgeChecker._interiors` of the helper process's arm (run there, one
     configuration at a time: :mod:`planner.helper`)."""
-    checker = MotionChecker(helper_arm(), joint_step, tcp_step)
-    return BatchEdgeChecker(checker, threads=1)._interiors(A, B, one_at_a_time=True)
+    arm = helper_arm()
+    key = (id(arm), joint_step, tcp_step)
+    if key not in _HELPER_CHECKERS:
+        _HELPER_CHECKERS.clear()
+        _HELPER_CHECKERS[key] = BatchEdgeChecker(MotionChecker(arm, joint_step, tcp_step), 1)
+    return _HELPER_CHECKERS[key]._interiors(A, B, one_at_a_time=True)
