@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 from ortools.constraint_solver import pywrapcp, routing_enums_pb2
 
-from planner.costs import CostTable, cost_matrix, travel_time
+from planner.costs import cost_matrix, cost_table, travel_time
 from planner.errors import PlanningError
 from planner.full_choice import layered_choice, task_space_order
 from planner.helper import Helper
@@ -197,7 +197,7 @@ class GtspSequencer:
         self.local = np.concatenate([[-1]] + [np.asarray(r) for r in self.reps]).astype(np.int64)
         offsets = np.cumsum([1] + [len(r) for r in self.reps])
         self.groups = [np.arange(offsets[h], offsets[h] + len(r)) for h, r in enumerate(self.reps)]
-        table = CostTable(
+        table = cost_table(
             limits.velocity, limits.acceleration, limits.jerk, limits.upper - limits.lower
         )
         self.G, held = symmetric_costs(table, self.nodes, helper)

@@ -49,3 +49,16 @@ def test_cost_matrix_and_table_agree_with_pairwise_times() -> None:
     table = CostTable(V, A, J, span_rad=np.full(6, 14.0))
     assert np.max(np.abs(table.matrix(X, Y) - M)) < 1e-3
     assert np.allclose(M, cost_matrix(Y, X, V, A, J).T)  # symmetric
+
+
+def test_cost_table_is_made_once_per_set_of_limits() -> None:
+    from planner.costs import cost_table
+
+    span = np.full(6, 14.0)
+    t1 = cost_table(V, A, J, span)
+    assert cost_table(V.copy(), A, J, span) is t1  # equal limits: the same table
+    other = cost_table(V * 0.5, A, J, span)
+    assert other is not t1
+    q = np.random.default_rng(2).uniform(-3, 3, (30, 6))
+    assert np.array_equal(t1.matrix(q, q), CostTable(V, A, J, span).matrix(q, q))
+    assert not np.array_equal(other.matrix(q, q), t1.matrix(q, q))
