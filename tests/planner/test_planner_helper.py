@@ -57,6 +57,27 @@ def test_motion_checks_split_with_a_helper_equal_one_process(cell) -> None:
     assert 0 < got.sum() < len(got) - 5  # both answers occur
 
 
+def test_motion_checks_of_a_helper_that_died_are_made_here(cell) -> None:
+    import os
+    import signal
+
+    arm = cell.build_arm()
+    checker = MotionChecker(arm, np.radians(3.0), 0.012)
+    rng = np.random.default_rng(8)
+    A = rng.uniform(arm.lower, arm.upper, (2 * HELPER_MIN_MOTIONS + 10, 6)) * 0.4
+    B = np.clip(A + rng.normal(scale=0.3, size=A.shape), arm.lower, arm.upper)
+    alone = BatchEdgeChecker(checker)
+    want = alone.free(A, B)
+    helper = Helper.start(MIN_HOLES, arm=arm)
+    for pid in list(helper.pool._processes):
+        os.kill(pid, signal.SIGKILL)
+    split = BatchEdgeChecker(checker)
+    got = split.free(A, B, helper)
+    assert helper.close() == 0.0
+    assert got.tolist() == want.tolist() and split.checks == alone.checks
+    assert 0 < got.sum() < len(got)
+
+
 def test_representatives_chosen_with_a_helper_equal_those_without(cell) -> None:
     from planner.representatives import every_representatives
     from planner.timing import JointLimits
