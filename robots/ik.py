@@ -191,40 +191,16 @@ def _wrist_solutions(
 
 def solve_opw(params: OpwParameters, T_base_tool0: Array, lower: Array, upper: Array) -> IKResult:
     """Every joint solution (URDF rad) placing ``tool0`` at ``T_base_tool0`` within limits."""
-    g = _geometry_of(params)
-    T = np.asarray(T_base_tool0, float)
-    T_E = T if g.T_tool0_e is None else T @ g.T_tool0_e
-    R = T_E[:3, :3].tolist()
-    p = T_E[:3, 3].tolist()
-    p_c = [p[i] - g.c4 * R[i][2] for i in range(3)]
-    arm, arm_reason = _arm_solutions(g, p_c)
-    if not arm:
-        return _empty(arm_reason, 0)
-    raw: list[tuple[float, ...]] = []
-    branches: list[int] = []
-    for q1, q2, q3, branch in arm:
-        for q4, q5, q6, flip in _wrist(q1, q2 + q3, R):
-            raw.append((q1, q2, q3, q4, q5, q6))
-            branches.append(branch + flip)
-    if not raw:
-        return _empty("wrist singular", 0)
-    Qc = np.array(raw)
-    keep = _verified(fk_dh(g.canonical_table, Qc), T_E)
-    if not keep.any():
-        return _empty("out of reach", len(raw))
-    Q = (Qc[keep] - g.offset) * g.sign
-    sols, branch_ids = expand_within_limits(Q, np.array(branches)[keep], lower, upper)
-    if not len(sols):
-        return _empty("outside limits", len(raw))
-    return IKResult(sols, branch_ids, None, len(raw))
+    return solve_opw_many(params, np.asarray(T_base_tool0, float)[None], lower, upper)[0]
 
 
 def solve_opw_many(
     params: OpwParameters, T_base_tool0: Array, lower: Array, upper: Array
 ) -> list[IKResult]:
-    """:func:`solve_opw` of each pose of ``T_base_tool0`` (P, 4, 4), the same results bit for
-    bit: the closed form pose by pose, the FK check and the 2*pi shifts of all poses' raw
-    solutions in one array call each (a hole's viewpoints: a fifth of the time)."""
+    """:func:`solve_opw` of each pose of ``T_base_tool0`` (P, 4, 4), the same results as one
+    pose at a time, bit for bit: the closed form pose by pose, the FK check and the 2*pi
+    shifts of all poses' raw solutions in one array call each (a hole's viewpoints: a fifth
+    of the time)."""
     g = _geometry_of(params)
     raw: list[tuple[float, ...]] = []
     branches: list[int] = []
@@ -244,12 +220,10 @@ def solve_opw_many(
         counts.append(len(raw) - n0)
         early.append(arm_reason if not arm else "wrist singular" if len(raw) == n0 else None)
         owner += [i] * (len(raw) - n0)
-    if not raw:
-        return [_empty(r or "out of reach", 0) for r in early]
-    Qc, rows_of = np.array(raw), np.array(owner, dtype=np.int64)
-    keep = _verified(fk_dh(g.canonical_table, Qc), np.array(targets)[rows_of])
+    Qc, rows_of = np.array(raw, dtype=float).reshape(-1, 6), np.array(owner, dtype=np.int64)
+    keep = _verified(fk_dh(g.canonical_table, Qc), np.array(targets).reshape(-1, 4, 4)[rows_of])
     sols, src = _expand(((Qc[keep] - g.offset) * g.sign), lower, upper)
-    bids = np.array(branches)[keep][src]
+    bids = np.array(branches, dtype=np.int64)[keep][src]
     pose_of = rows_of[keep][src]
     verified = np.bincount(rows_of[keep], minlength=len(targets))
     cut = np.searchsorted(pose_of, np.arange(len(targets) + 1))
@@ -281,19 +255,9 @@ def solve_ik(table: DHTable, T_base_tool0: Array, lower: Array, upper: Array) ->
     return result
 
 
-def expand_within_limits(
-    Q: Array, branches: NDArray[np.int64], lower: Array, upper: Array
-) -> tuple[Array, NDArray[np.int64]]:
-    """Every row of ``Q`` with each joint replaced by all its values 2*pi apart within limits.
-
-    Rows with a joint that has no such value are dropped. Returns ``(solutions, branches)``.
-    """
-    sols, rows = _expand(Q, lower, upper)
-    return sols, branches[rows]
-
-
 def _expand(Q: Array, lower: Array, upper: Array) -> tuple[Array, NDArray[np.int64]]:
-    """:func:`expand_within_limits`' solutions and, for each, its row of ``Q``."""
+    """Every row of ``Q`` with each joint replaced by all its values 2*pi apart within limits
+    (rows with a joint that has no such value are dropped), and each solution's row of ``Q``."""
     grid, lo, hi = _shift_grid(
         tuple(np.asarray(lower, float).tolist()), tuple(np.asarray(upper, float).tolist())
     )
