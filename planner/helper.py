@@ -5,8 +5,8 @@ motion checks are independent per hole and per motion. While :meth:`TourPlanner.
 computes them, a :class:`Helper` — one process forked from this one, so it starts at once
 with the arm already built — takes a share: chunks of holes from the back of the list
 while this process works from the front (:func:`planner.viewpoints.all_hole_candidates`),
-and every other roadmap motion (:meth:`planner.edge_check.BatchEdgeChecker.free`), each
-process checking one configuration per call. Every answer is a function of its hole or
+and chunks of the roadmap's motions the same way (:meth:`planner.edge_check.BatchEdgeChecker.free`),
+each process checking one configuration per call. Every answer is a function of its hole or
 motion alone, so the results, the tour and the collision-check counts are the same with
 or without the helper, whichever process computed what.
 
