@@ -91,9 +91,9 @@ class BatchEdgeChecker:
         """:meth:`_interiors` of the motions ``A`` → ``B``, in ``SHARE_CHUNKS`` chunks (every
         ``SHARE_CHUNKS``-th motion: chunks of equal cost) that the helper takes from the last
         while this process takes them from the first, one configuration per call; a chunk
-        the helper has not started when this process reaches it is done here. Returns the
-        arrays, filled where this process worked, and the call that fills in the helper's
-        chunks (waiting for them)."""
+        not yet handed to the helper (its executor queues up to two ahead) when this process
+        reaches it is done here. Returns the arrays, filled where this process worked, and the
+        call that fills in the helper's chunks (waiting for them)."""
         c = self.checker
         chunks = [np.arange(j, len(A), SHARE_CHUNKS) for j in range(SHARE_CHUNKS)]
         futures = {
