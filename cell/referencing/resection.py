@@ -151,6 +151,21 @@ def _pose_jacobian(
     return np.concatenate([Jw, -M @ R.T], axis=2).reshape(-1, 6)
 
 
+def _problem(
+    view: MarkerView,
+    stereo: StereoCalibration,
+    marker_ids: tuple[str, ...],
+    positions: Array,
+    sigma_px: float,
+) -> tuple[dict[str, int], tuple]:
+    """The markers' index by id and the arguments of :func:`_residuals` and
+    :func:`_pose_jacobian` for ``view``: ``(T0, obs, positions, K, T_lr, sigma_px)``."""
+    index = {m: k for k, m in enumerate(marker_ids)}
+    K = (np.asarray(stereo.K_left, float), np.asarray(stereo.K_right, float))
+    T0 = np.asarray(view.T_cell_left_prior, float)
+    return index, (T0, _Obs(view, stereo, index), positions, K, T_left_right(stereo), sigma_px)
+
+
 def resect(
     view: MarkerView,
     stereo: StereoCalibration,
@@ -164,17 +179,15 @@ def resect(
     frame; their covariance (3n, 3n) m² or None) (module doc). ``sigma_px`` weighs the centres
     and sets the outlier limit; the image noise's covariance is stated at ``image_sigma_px``
     (default ``sigma_px``; :mod:`cell.referencing.sigma`)."""
-    index = {m: k for k, m in enumerate(marker_ids)}
-    obs = _Obs(view, stereo, index)
-    K = (np.asarray(stereo.K_left, float), np.asarray(stereo.K_right, float))
-    T_lr, T0 = T_left_right(stereo), np.asarray(view.T_cell_left_prior, float)
+    index, args = _problem(view, stereo, marker_ids, positions, sigma_px)
+    obs = args[1]
     refused: dict[str, str] = {}
     while True:
         used = sorted({marker_ids[j] for j in obs.marker})
         if len(used) < MIN_MARKERS:
             why = f"{len(used)} usable markers, {MIN_MARKERS} needed"
-            return Resection(False, T0, np.full((6, 6), np.nan), tuple(used), refused, reason=why)
-        args = (T0, obs, positions, K, T_lr, sigma_px)
+            return Resection(False, args[0], np.full((6, 6), np.nan), tuple(used), refused,
+                             reason=why)  # fmt: skip
         sol = least_squares(_residuals, np.zeros(6), jac=_pose_jacobian, args=args, method="lm",
                             x_scale=1.0, xtol=XTOL, ftol=FTOL)  # fmt: skip
         r = sol.fun.reshape(-1, 2)
@@ -205,12 +218,8 @@ def resect_near(
     demo's stops the poses agree with the full resection's to 2e-10. When a marker then lies
     over :data:`OUTLIER_SIGMA`, or fewer than :data:`MIN_MARKERS` remain, the full
     :func:`resect` decides."""
-    index = {m: k for k, m in enumerate(marker_ids)}
-    obs = _Obs(view, stereo, index)
-    K = (np.asarray(stereo.K_left, float), np.asarray(stereo.K_right, float))
-    T0 = np.asarray(view.T_cell_left_prior, float)
-    args = (T0, obs, positions, K, T_left_right(stereo), sigma_px)
-    used = sorted({marker_ids[j] for j in obs.marker})
+    _, args = _problem(view, stereo, marker_ids, positions, sigma_px)
+    used = sorted({marker_ids[j] for j in args[1].marker})
     if len(used) >= MIN_MARKERS:
         J0, r0 = _pose_jacobian(np.zeros(6), *args), _residuals(np.zeros(6), *args)
         x = -np.linalg.solve(J0.T @ J0, J0.T @ r0)
